@@ -1,0 +1,135 @@
+// Shared by every compute pass: the body layout, the per-step parameters and
+// the quaternion helpers. Every struct here has a #[repr(C)] twin in
+// src/gpu/types.rs, checked member by member by tests/layouts.rs.
+
+// Pose of one body: what swaps between the two state buffers every pass.
+// 64 bytes. Quaternions are (x, y, z, w).
+struct BodyState {
+    pos: vec4<f32>,      // xyz = centre of mass (m); w unused
+    prev_pos: vec4<f32>, // xyz = centre of mass one step ago
+    rot: vec4<f32>,      // orientation, unit quaternion
+    prev_rot: vec4<f32>, // orientation one step ago
+}
+
+// What rarely changes: shape, mass and material. 64 bytes.
+struct BodyProps {
+    half_extents: vec4<f32>, // box: xyz half extents; sphere: radius in x; w = bounding radius
+    inv_inertia: vec4<f32>,  // xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg)
+    material: vec4<f32>,     // x = restitution, y = friction, zw unused
+    kind: vec4<u32>,         // x = SHAPE_*, y = FLAG_* bits, zw unused
+}
+
+// Velocities just after integration, before any constraint: the approach
+// velocities that restitution reflects. 32 bytes.
+struct Velocity {
+    linear: vec4<f32>,  // m/s
+    angular: vec4<f32>, // rad/s, world frame
+}
+
+// Per-step parameters, one 256-byte slot per step of a submitted batch.
+struct Params {
+    gravity: vec4<f32>,      // xyz (m/s^2); w = ground height (m)
+    dt: f32,                 // this step (s)
+    dt_prev: f32,            // the step that produced pos - prev_pos (s)
+    relaxation: f32,         // the paper's c_r
+    linear_damping: f32,     // the paper's beta, per step
+    angular_damping: f32,    // beta for rotation, per step
+    body_count: u32,
+    has_ground: u32,         // 1 if the ground plane exists
+    ground_restitution: f32, // the ground's material (settings.restitution)
+    ground_friction: f32,    // the ground's material (settings.friction)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+const SHAPE_BOX: u32 = 0u;
+const SHAPE_SPHERE: u32 = 1u;
+const FLAG_FIXED: u32 = 1u;
+
+// Threads per workgroup of every per-body pass.
+const WORKGROUP: u32 = 64u;
+
+// Hamilton product a * b.
+fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(
+        a.w * b.xyz + b.w * a.xyz + cross(a.xyz, b.xyz),
+        a.w * b.w - dot(a.xyz, b.xyz),
+    );
+}
+
+fn quat_conj(q: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(-q.xyz, q.w);
+}
+
+fn quat_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
+    let t = 2.0 * cross(q.xyz, v);
+    return v + q.w * t + cross(q.xyz, t);
+}
+
+// atan(x) for 0 <= x, without the builtin: Vulkan lets atan2, sin and cos be
+// off by 2^-11 absolute, which a spinning body integrates into drift. Two
+// half-angle reductions bring x under 0.27, where the odd series to x^11 is
+// good to about 1e-8.
+fn atan_precise(x_in: f32) -> f32 {
+    var x = x_in;
+    var scale = 1.0;
+    for (var k = 0; k < 2; k = k + 1) {
+        if (x > 0.27) {
+            x = x / (1.0 + sqrt(1.0 + x * x));
+            scale = scale * 2.0;
+        }
+    }
+    let x2 = x * x;
+    let series = x * (1.0 + x2 * (-1.0 / 3.0 + x2 * (1.0 / 5.0 + x2 * (-1.0 / 7.0 + x2 * (1.0 / 9.0 - x2 / 11.0)))));
+    return scale * series;
+}
+
+// Rotation vector (axis * angle, radians) of a unit quaternion, short way round.
+fn quat_to_rotvec(q_in: vec4<f32>) -> vec3<f32> {
+    var q = q_in;
+    if (q.w < 0.0) {
+        q = -q;
+    }
+    let s = length(q.xyz);
+    if (s < 1e-12) {
+        return 2.0 * q.xyz;
+    }
+    var half_angle: f32;
+    if (s <= q.w) {
+        half_angle = atan_precise(s / q.w);
+    } else {
+        half_angle = 1.5707964 - atan_precise(q.w / s);
+    }
+    return q.xyz * (2.0 * half_angle / s);
+}
+
+// Unit quaternion of a rotation vector; a series for the small angles of one
+// step (see atan_precise for why not the builtins).
+fn quat_from_rotvec(v: vec3<f32>) -> vec4<f32> {
+    let angle = length(v);
+    let h = 0.5 * angle;
+    if (h < 0.5) {
+        let h2 = h * h;
+        // sin(h) / h and cos(h), series to h^10
+        let sinc = 1.0 + h2 * (-1.0 / 6.0 + h2 * (1.0 / 120.0 + h2 * (-1.0 / 5040.0 + h2 * (1.0 / 362880.0))));
+        let c = 1.0 + h2 * (-0.5 + h2 * (1.0 / 24.0 + h2 * (-1.0 / 720.0 + h2 * (1.0 / 40320.0 - h2 / 3628800.0))));
+        return normalize(vec4<f32>(0.5 * v * sinc, c));
+    }
+    return vec4<f32>(v * (sin(h) / angle), cos(h));
+}
+
+// Apply a small world-frame rotation dtheta (radians) to q: q' = q + 1/2 (dtheta, 0) q.
+fn quat_add_rotation(q: vec4<f32>, dtheta: vec3<f32>) -> vec4<f32> {
+    return normalize(q + 0.5 * quat_mul(vec4<f32>(dtheta, 0.0), q));
+}
+
+// World-frame inverse inertia applied to v: R diag(inv_i) R^T v.
+fn inv_inertia_world(q: vec4<f32>, inv_i: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    let local = quat_rotate(quat_conj(q), v);
+    return quat_rotate(q, inv_i * local);
+}
+
+fn is_fixed(p: BodyProps) -> bool {
+    return (p.kind.y & FLAG_FIXED) != 0u;
+}

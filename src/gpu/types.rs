@@ -1,0 +1,72 @@
+//! Host twins of the structs in `shaders/common.wgsl`. Each is `#[repr(C)]`
+//! with its padding written out; `tests/layouts.rs` checks every member's
+//! name and offset and the size against the WGSL.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Pose of one body (64 bytes): what swaps between the two state buffers.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BodyState {
+    /// xyz = centre of mass (m); w unused.
+    pub pos: [f32; 4],
+    /// Centre of mass one step ago (m).
+    pub prev_pos: [f32; 4],
+    /// Orientation, unit quaternion (x, y, z, w).
+    pub rot: [f32; 4],
+    /// Orientation one step ago.
+    pub prev_rot: [f32; 4],
+}
+
+/// Shape, mass and material of one body (64 bytes), read-only on the GPU.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BodyProps {
+    /// Box: half extents (m); sphere: radius in x. w = bounding radius (m).
+    pub half_extents: [f32; 4],
+    /// xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg).
+    pub inv_inertia: [f32; 4],
+    /// x = restitution, y = friction.
+    pub material: [f32; 4],
+    /// x = shape (`SHAPE_BOX`, `SHAPE_SPHERE`), y = flags (`FLAG_FIXED`).
+    pub kind: [u32; 4],
+}
+
+/// Velocity after integration, before constraints (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Velocity {
+    pub linear: [f32; 4],
+    pub angular: [f32; 4],
+}
+
+/// Per-step parameters (64 bytes, stored in 256-byte slots).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Params {
+    /// xyz = gravity (m/s^2); w = ground height (m).
+    pub gravity: [f32; 4],
+    pub dt: f32,
+    pub dt_prev: f32,
+    pub relaxation: f32,
+    pub linear_damping: f32,
+    pub angular_damping: f32,
+    pub body_count: u32,
+    pub has_ground: u32,
+    pub ground_restitution: f32,
+    pub ground_friction: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+pub const SHAPE_BOX: u32 = 0;
+pub const SHAPE_SPHERE: u32 = 1;
+pub const FLAG_FIXED: u32 = 1;
+
+/// Threads per workgroup of every per-body pass (`WORKGROUP` in WGSL).
+pub const WORKGROUP: u32 = 64;
+
+/// Byte stride between the per-step `Params` slots of a batch: the
+/// uniform-buffer offset alignment WebGPU guarantees to work everywhere.
+pub const PARAMS_STRIDE: u64 = 256;

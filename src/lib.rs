@@ -1,0 +1,46 @@
+//! `verlet`: a GPU-first rigid-body simulator after Kenwright's "A
+//! Lightweight Rigid-Body Verlet Simulator for Real-Time Environments".
+//!
+//! Quaternion position-Verlet integration, contacts enforced by corrective
+//! snaps of pose relaxed iteratively, all in WGSL compute kernels; the host
+//! sets up, steps, and reads back only on request.
+//!
+//! ```no_run
+//! use verlet::{scenes, World};
+//! let scene = scenes::drop();
+//! let mut world = World::new(&scene)?;
+//! world.step(120)?;
+//! let bodies = world.read_state()?;
+//! println!("box at {:?}", bodies[0].position);
+//! # Ok::<(), verlet::Error>(())
+//! ```
+
+pub mod gpu;
+pub mod output;
+pub mod scene;
+pub mod scenes;
+pub mod step;
+pub mod world;
+
+pub use scene::{Body, Ground, Joint, Scene, SceneError, Settings, Shape};
+pub use world::{BodyOutput, World};
+
+/// Everything that can go wrong, each with a one-line reason.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("{0}")]
+    Scene(#[from] scene::SceneError),
+    #[error("{0}")]
+    Gpu(#[from] gpu::GpuError),
+    /// The scene does not fit the adapter's limits; nothing was allocated.
+    #[error("scene too large: {0}")]
+    Capacity(String),
+    /// A bad argument to the library or the command line.
+    #[error("{0}")]
+    Input(String),
+    /// The simulation produced a non-finite number.
+    #[error("simulation diverged: {0}")]
+    Diverged(String),
+    #[error("{path}: {source}")]
+    Io { path: String, source: std::io::Error },
+}

@@ -1,0 +1,231 @@
+//! Named built-in scenes, shared by the command line (`verlet scene NAME`),
+//! the tests and the benchmarks: a name means one scene everywhere.
+
+use crate::scene::{Body, Ground, Joint, Scene, Settings, Shape};
+
+/// A box body at rest with density 1000 kg/m^3.
+pub fn box_body(half_extents: [f32; 3], position: [f32; 3]) -> Body {
+    let h = half_extents;
+    Body {
+        shape: Shape::Box { half_extents: h },
+        position,
+        orientation: [0.0, 0.0, 0.0, 1.0],
+        linear_velocity: [0.0; 3],
+        angular_velocity: [0.0; 3],
+        mass: 1000.0 * 8.0 * h[0] * h[1] * h[2],
+        fixed: false,
+        restitution: None,
+        friction: None,
+    }
+}
+
+/// A sphere body at rest with density 1000 kg/m^3.
+pub fn sphere_body(radius: f32, position: [f32; 3]) -> Body {
+    Body {
+        shape: Shape::Sphere { radius },
+        mass: 1000.0 * 4.0 / 3.0 * std::f32::consts::PI * radius.powi(3),
+        ..box_body([radius; 3], position)
+    }
+}
+
+fn scene(bodies: Vec<Body>, joints: Vec<Joint>) -> Scene {
+    Scene { settings: Settings::default(), ground: Some(Ground { height: 0.0 }), bodies, joints, camera: None }
+}
+
+/// `drop`: one unit box, tilted 25 degrees about z, falling from 3 m.
+pub fn drop() -> Scene {
+    let mut b = box_body([0.5; 3], [0.0, 3.0, 0.0]);
+    let half = 25f32.to_radians() / 2.0;
+    b.orientation = [0.0, 0.0, half.sin(), half.cos()];
+    scene(vec![b], vec![])
+}
+
+/// `sphere`: a ball of radius 0.5 dropped from 5 m with restitution 0.8.
+pub fn sphere() -> Scene {
+    let mut b = sphere_body(0.5, [0.0, 5.0, 0.0]);
+    b.restitution = Some(0.8);
+    scene(vec![b], vec![])
+}
+
+/// `cubes`: `count` unit cubes at random positions and orientations in a
+/// column of air above the ground, about one cube per 3.4 m^3, so the
+/// density is the same at every count.
+pub fn cubes(count: usize, seed: u64) -> Scene {
+    let mut rng = SplitMix64(seed);
+    let side = ((count as f32 * 1.5).sqrt()).ceil().max(1.0); // cells per row
+    let layers = (count as f32 / (side * side)).ceil().max(1.0);
+    let spacing = 1.5;
+    let mut bodies = Vec::with_capacity(count);
+    'fill: for layer in 0..layers as usize {
+        for row in 0..side as usize {
+            for col in 0..side as usize {
+                if bodies.len() == count {
+                    break 'fill;
+                }
+                let jitter = |r: &mut SplitMix64| (r.next_f32() - 0.5) * 0.3;
+                let x = (col as f32 - side / 2.0) * spacing + jitter(&mut rng);
+                let z = (row as f32 - side / 2.0) * spacing + jitter(&mut rng);
+                let y = 1.0 + layer as f32 * spacing + rng.next_f32() * 0.3;
+                let mut b = box_body([0.5; 3], [x, y, z]);
+                b.orientation = rng.unit_quaternion();
+                bodies.push(b);
+            }
+        }
+    }
+    scene(bodies, vec![])
+}
+
+/// `stack`: `count` unit boxes in a column, each resting on the one below.
+pub fn stack(count: usize) -> Scene {
+    let bodies = (0..count).map(|k| box_body([0.5; 3], [0.0, 0.5 + k as f32, 0.0])).collect();
+    scene(bodies, vec![])
+}
+
+/// `pyramid`: `rows` rows of unit boxes, the bottom row `rows` wide, with a
+/// 0.05 m gap between neighbours of a row.
+pub fn pyramid(rows: usize) -> Scene {
+    let pitch = 1.05;
+    let mut bodies = Vec::new();
+    for row in 0..rows {
+        let n = rows - row;
+        let x0 = -(n as f32 - 1.0) * pitch / 2.0;
+        for k in 0..n {
+            bodies.push(box_body([0.5; 3], [x0 + k as f32 * pitch, 0.5 + row as f32, 0.0]));
+        }
+    }
+    scene(bodies, vec![])
+}
+
+/// `chain`: `count` links (half extents 0.5 x 0.1 x 0.1) laid out along +x,
+/// joined end to end, the first end pinned to the world at (0, h, 0).
+pub fn chain(count: usize) -> Scene {
+    let height = count as f32 + 2.0;
+    let bodies = (0..count).map(|k| box_body([0.5, 0.1, 0.1], [0.5 + k as f32, height, 0.0])).collect();
+    let mut joints = vec![Joint { bodies: [0, -1], anchors: [[-0.5, 0.0, 0.0], [0.0, height, 0.0]] }];
+    for k in 1..count {
+        joints.push(Joint { bodies: [k as i32 - 1, k as i32], anchors: [[0.5, 0.0, 0.0], [-0.5, 0.0, 0.0]] });
+    }
+    scene(bodies, joints)
+}
+
+/// `bridge`: `count` planks (half extents 0.5 x 0.05 x 1) on ball joints at
+/// both edges of each end, between two fixed posts.
+pub fn bridge(count: usize) -> Scene {
+    let height = 3.0;
+    let span = count as f32;
+    let post = |x: f32| {
+        let mut b = box_body([0.5, height / 2.0, 1.0], [x, height / 2.0, 0.0]);
+        b.fixed = true;
+        b
+    };
+    let mut bodies = vec![post(-0.5), post(span + 0.5)];
+    for k in 0..count {
+        bodies.push(box_body([0.5, 0.05, 1.0], [k as f32 + 0.5, height - 0.05, 0.0]));
+    }
+    let mut joints = Vec::new();
+    for z in [-0.9f32, 0.9] {
+        for k in 0..=count {
+            // joint between plank k-1 (or the left post) and plank k (or the right post)
+            let left = if k == 0 { 0 } else { k as i32 + 1 };
+            let right = if k == count { 1 } else { k as i32 + 2 };
+            let left_anchor = if k == 0 { [0.5, height / 2.0 - 0.05, z] } else { [0.5, 0.0, z] };
+            let right_anchor = if k == count { [-0.5, height / 2.0 - 0.05, z] } else { [-0.5, 0.0, z] };
+            joints.push(Joint { bodies: [left, right], anchors: [left_anchor, right_anchor] });
+        }
+    }
+    scene(bodies, joints)
+}
+
+/// `ragdoll`: `count` ragdolls (head, torso, upper and lower arms and legs on
+/// ball joints) dropped in a row onto a pile of boxes.
+pub fn ragdoll(count: usize) -> Scene {
+    let mut bodies = Vec::new();
+    let mut joints = Vec::new();
+    // the pile: a 3 x 3 base of boxes with one box on top
+    for i in 0..3 {
+        for k in 0..3 {
+            bodies.push(box_body([0.5; 3], [i as f32 * 1.05 - 1.05, 0.5, k as f32 * 1.05 - 1.05]));
+        }
+    }
+    bodies.push(box_body([0.5; 3], [0.0, 1.5, 0.0]));
+    for r in 0..count {
+        let base = bodies.len() as i32;
+        let (x, y, z) = ((r % 3) as f32 * 0.8 - 0.8, 3.5 + (r / 3) as f32 * 2.5, (r % 2) as f32 * 0.5 - 0.25);
+        let mut part = |half: [f32; 3], at: [f32; 3]| {
+            bodies.push(box_body(half, [x + at[0], y + at[1], z + at[2]]));
+        };
+        part([0.2, 0.3, 0.12], [0.0, 0.0, 0.0]); // 0 torso
+        part([0.12, 0.12, 0.12], [0.0, 0.45, 0.0]); // 1 head
+        for side in [-1.0f32, 1.0] {
+            part([0.15, 0.05, 0.05], [side * 0.35, 0.25, 0.0]); // upper arm
+            part([0.15, 0.05, 0.05], [side * 0.65, 0.25, 0.0]); // lower arm
+            part([0.07, 0.2, 0.07], [side * 0.1, -0.5, 0.0]); // upper leg
+            part([0.07, 0.2, 0.07], [side * 0.1, -0.9, 0.0]); // lower leg
+        }
+        let j = |a: i32, b: i32, pa: [f32; 3], pb: [f32; 3]| Joint { bodies: [base + a, base + b], anchors: [pa, pb] };
+        joints.push(j(0, 1, [0.0, 0.33, 0.0], [0.0, -0.12, 0.0])); // neck
+        for (s, side) in [(0, -1.0f32), (1, 1.0)] {
+            let ua = 2 + s * 4;
+            joints.push(j(0, ua, [side * 0.2, 0.25, 0.0], [-side * 0.15, 0.0, 0.0])); // shoulder
+            joints.push(j(ua, ua + 1, [side * 0.15, 0.0, 0.0], [-side * 0.15, 0.0, 0.0])); // elbow
+            joints.push(j(0, ua + 2, [side * 0.1, -0.3, 0.0], [0.0, 0.2, 0.0])); // hip
+            joints.push(j(ua + 2, ua + 3, [0.0, -0.2, 0.0], [0.0, 0.2, 0.0])); // knee
+        }
+    }
+    scene(bodies, joints)
+}
+
+/// The names `verlet scene` knows, with a line on each.
+pub const NAMES: &[(&str, &str)] = &[
+    ("drop", "one unit box falling tilted from 3 m onto the ground"),
+    ("sphere", "one ball (restitution 0.8) dropped from 5 m"),
+    ("cubes", "--count random unit cubes falling (--seed)"),
+    ("stack", "--count unit boxes in a column"),
+    ("pyramid", "--count rows of unit boxes"),
+    ("chain", "--count links on ball joints, pinned at one end, laid out horizontally"),
+    ("bridge", "--count planks on ball joints between two fixed posts"),
+    ("ragdoll", "--count ragdolls dropped onto a pile of boxes"),
+];
+
+/// The named scene; `count` defaults per scene when `None`.
+pub fn by_name(name: &str, count: Option<usize>, seed: u64) -> Option<Scene> {
+    Some(match name {
+        "drop" => drop(),
+        "sphere" => sphere(),
+        "cubes" => cubes(count.unwrap_or(1000), seed),
+        "stack" => stack(count.unwrap_or(10)),
+        "pyramid" => pyramid(count.unwrap_or(10)),
+        "chain" => chain(count.unwrap_or(21)),
+        "bridge" => bridge(count.unwrap_or(20)),
+        "ragdoll" => ragdoll(count.unwrap_or(10)),
+        _ => return None,
+    })
+}
+
+/// SplitMix64: a tiny generator whose sequence for a seed is fixed forever,
+/// so `cubes --seed S` names the same scene in every version of this crate
+/// (a general-purpose RNG crate may change its streams between releases).
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    fn next_f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// A uniformly random rotation (Shoemake's method).
+    fn unit_quaternion(&mut self) -> [f32; 4] {
+        let (u1, u2, u3) = (self.next_f32(), self.next_f32(), self.next_f32());
+        let tau = std::f32::consts::TAU;
+        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+        [a * (tau * u2).sin(), a * (tau * u2).cos(), b * (tau * u3).sin(), b * (tau * u3).cos()]
+    }
+}

@@ -1,0 +1,146 @@
+//! Known answers for the integrator and the ground contacts (issue 2).
+
+mod common;
+
+use common::{quat, v3, world};
+use glam::{DVec3, Quat, Vec3};
+use verlet::scenes::{box_body, sphere_body};
+use verlet::{Ground, Scene, Settings};
+
+fn empty(settings: Settings, ground: bool) -> Scene {
+    Scene { settings, ground: ground.then_some(Ground { height: 0.0 }), bodies: vec![], joints: vec![], camera: None }
+}
+
+fn parabola(x0: [f32; 3], v0: [f32; 3], g: [f32; 3], t: f64) -> DVec3 {
+    let f = |a: [f32; 3]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+    f(x0) + f(v0) * t + 0.5 * f(g) * t * t
+}
+
+#[test]
+fn projectile_stays_on_its_parabola() {
+    let mut scene = empty(Settings::default(), false);
+    let (x0, v0) = ([0.0, 1.0, 0.0], [3.0, 8.0, -1.0]);
+    let mut b = box_body([0.2; 3], x0);
+    b.linear_velocity = v0;
+    scene.bodies.push(b);
+    let Some(mut w) = world(&scene) else { return };
+    let mut worst = 0.0f64;
+    for _ in 0..12 {
+        w.step(10).unwrap();
+        let s = w.read_state().unwrap();
+        let want = parabola(x0, v0, scene.settings.gravity, w.time());
+        worst = worst.max((v3(s[0].position).as_dvec3() - want).length());
+    }
+    assert!((w.time() - 2.0).abs() < 1e-4);
+    assert!(worst < 0.002, "left the parabola by {worst} m");
+}
+
+#[test]
+fn time_corrected_verlet_follows_the_parabola_when_dt_alternates() {
+    let mut scene = empty(Settings::default(), false);
+    let (x0, v0) = ([0.0, 1.0, 0.0], [2.0, 9.0, 0.5]);
+    let mut b = sphere_body(0.2, x0);
+    b.linear_velocity = v0;
+    scene.bodies.push(b);
+    let Some(mut w) = world(&scene) else { return };
+    let mut worst = 0.0f64;
+    // 2 s as 80 pairs of 1/60 s and 1/120 s
+    for _ in 0..20 {
+        let dts: Vec<f32> = (0..8).map(|k| if k % 2 == 0 { 1.0 / 60.0 } else { 1.0 / 120.0 }).collect();
+        w.step_with(&dts).unwrap();
+        let s = w.read_state().unwrap();
+        let want = parabola(x0, v0, scene.settings.gravity, w.time());
+        worst = worst.max((v3(s[0].position).as_dvec3() - want).length());
+    }
+    assert!((w.time() - 2.0).abs() < 1e-3, "time {}", w.time());
+    assert!(worst < 0.005, "left the parabola by {worst} m");
+}
+
+#[test]
+fn box_spinning_about_a_principal_axis_keeps_its_spin() {
+    let mut scene = empty(Settings { gravity: [0.0; 3], ..Settings::default() }, false);
+    let q0 = Quat::from_rotation_x(0.3);
+    let omega = q0 * Vec3::new(0.0, 0.0, 3.0); // the body's own z axis, in world axes
+    let mut b = box_body([0.5, 0.3, 0.2], [0.0, 0.0, 0.0]);
+    b.orientation = q0.to_array();
+    b.angular_velocity = omega.to_array();
+    scene.bodies.push(b);
+    let Some(mut w) = world(&scene) else { return };
+    for _ in 0..24 {
+        w.step(10).unwrap();
+        let s = w.read_state().unwrap()[0];
+        let q = quat(s.orientation);
+        assert!((q.length() - 1.0).abs() < 1e-4, "|q| = {}", q.length());
+        let err = (v3(s.angular_velocity) - omega).length() / omega.length();
+        assert!(err < 0.01, "spin changed by {:.3}% at t = {}", err * 100.0, w.time());
+    }
+    let q = quat(w.read_state().unwrap()[0].orientation);
+    let predicted = Quat::from_scaled_axis(omega * w.time() as f32) * q0;
+    let angle = predicted.angle_between(q);
+    assert!(angle < 0.01, "ended {angle} rad away from the predicted orientation");
+}
+
+#[test]
+fn linear_damping_decays_speed_as_eq_12() {
+    let beta = 0.05f32;
+    let settings = Settings { gravity: [0.0; 3], linear_damping: beta, ..Settings::default() };
+    let mut scene = empty(settings, false);
+    let mut b = box_body([0.5; 3], [0.0; 3]);
+    b.linear_velocity = [4.0, 0.0, 0.0];
+    scene.bodies.push(b);
+    let Some(mut w) = world(&scene) else { return };
+    for _ in 0..6 {
+        w.step(10).unwrap();
+        let v = v3(w.read_state().unwrap()[0].linear_velocity).length() as f64;
+        let want = 4.0 * (1.0 - beta as f64).powi(w.step_count() as i32);
+        assert!((v - want).abs() / want < 1e-3, "speed {v}, eq. 12 says {want} after {} steps", w.step_count());
+    }
+}
+
+#[test]
+fn sphere_rebounds_to_restitution_squared_of_its_fall() {
+    let scene = verlet::scenes::sphere();
+    let Some(mut w) = world(&scene) else { return };
+    let radius = 0.5;
+    let fall = 5.0 - radius;
+    // fall, bounce, and find the top of the first rebound
+    let mut bounced = false;
+    let mut top = 0.0f32;
+    for _ in 0..240 {
+        w.step(1).unwrap();
+        let s = w.read_state().unwrap()[0];
+        if !bounced && s.linear_velocity[1] > 0.0 {
+            bounced = true;
+        }
+        if bounced {
+            if s.linear_velocity[1] < 0.0 {
+                break;
+            }
+            top = top.max(s.position[1]);
+        }
+    }
+    assert!(bounced, "never bounced");
+    let ratio = (top - radius) / fall;
+    assert!((ratio - 0.64).abs() < 0.064, "rebound ratio {ratio}, want 0.64 within 10%");
+}
+
+#[test]
+fn tilted_box_comes_to_rest_flat() {
+    let scene = verlet::scenes::drop();
+    let Some(mut w) = world(&scene) else { return };
+    w.step(300).unwrap();
+    let s = w.read_state().unwrap()[0];
+    let up = quat(s.orientation) * Vec3::Y;
+    // any face may end up down: tilt is the angle of the nearest body axis to vertical
+    let q = quat(s.orientation);
+    let tilt = [Vec3::X, Vec3::Y, Vec3::Z]
+        .iter()
+        .map(|a| (q * *a).dot(Vec3::Y).abs().clamp(0.0, 1.0).acos())
+        .fold(f32::MAX, f32::min)
+        .to_degrees();
+    let _ = up;
+    assert!((s.position[1] - 0.5).abs() < 0.01, "centre at {} m, want 0.5", s.position[1]);
+    assert!(tilt < 1.0, "tilted {tilt} degrees");
+    let speed = v3(s.linear_velocity).length();
+    assert!(speed < 0.01, "still moving at {speed} m/s");
+}
