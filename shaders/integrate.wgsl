@@ -3,7 +3,7 @@
 // (eq. 12). Reads state_in, writes each body's own slot of state_out (the
 // predicted pose, with the current pose as its previous one) and of vel0.
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(WORKGROUP)
 fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.body_count) {

@@ -4,7 +4,7 @@
 // with -e times its approach speed along the normal; slower ones stay at
 // rest, so resting bodies do not hop.
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(WORKGROUP)
 fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.body_count) {

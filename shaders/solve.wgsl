@@ -41,7 +41,7 @@ fn solve_ground_point(s: ptr<function, BodyState>, p: BodyProps, k: u32) {
     snap(s, p, r_now, -t, undo / effective_inv_mass(p, (*s).rot, r_now, t));
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(WORKGROUP)
 fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.body_count) {

@@ -1,0 +1,61 @@
+//! Every struct shared with WGSL matches its Rust twin member by member:
+//! names, byte offsets and size.
+
+use std::mem::{offset_of, size_of};
+
+use naga::TypeInner;
+use verlet::gpu::{shaders, types::*};
+
+/// (member name, offset) of a WGSL struct, and its size.
+fn wgsl_layout(source: &str, name: &str) -> (Vec<(String, u32)>, u32) {
+    let module = shaders::validate(source).expect("validates");
+    for (_, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let TypeInner::Struct { members, span } = &ty.inner {
+                let m = members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect();
+                return (m, *span);
+            }
+        }
+    }
+    panic!("struct {name} not found in the WGSL");
+}
+
+macro_rules! check_layout {
+    ($source:expr, $ty:ident { $($field:ident),* $(,)? }) => {{
+        let rust: Vec<(String, u32)> = vec![$((stringify!($field).to_string(), offset_of!($ty, $field) as u32)),*];
+        let (wgsl, span) = wgsl_layout($source, stringify!($ty));
+        assert_eq!(wgsl, rust, "{}: members (name, offset) differ between WGSL and Rust", stringify!($ty));
+        assert_eq!(span as usize, size_of::<$ty>(), "{}: size differs", stringify!($ty));
+    }};
+}
+
+#[test]
+fn shared_structs_match_member_by_member() {
+    let common = shaders::COMMON;
+    check_layout!(common, BodyState { pos, prev_pos, rot, prev_rot });
+    check_layout!(common, BodyProps { half_extents, inv_inertia, material, kind });
+    check_layout!(common, Velocity { linear, angular });
+    check_layout!(
+        common,
+        Params {
+            gravity, dt, dt_prev, relaxation, linear_damping, angular_damping, body_count, has_ground,
+            ground_restitution, ground_friction, _pad0, _pad1, _pad2
+        }
+    );
+}
+
+#[test]
+fn constants_match() {
+    let module = shaders::validate(shaders::COMMON).unwrap();
+    let find = |name: &str| {
+        let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref e => panic!("{name}: unexpected {e:?}"),
+        }
+    };
+    assert_eq!(find("SHAPE_BOX"), SHAPE_BOX);
+    assert_eq!(find("SHAPE_SPHERE"), SHAPE_SPHERE);
+    assert_eq!(find("FLAG_FIXED"), FLAG_FIXED);
+    assert_eq!(find("WORKGROUP"), WORKGROUP);
+}
