@@ -17,6 +17,7 @@
 
 pub mod gpu;
 pub mod output;
+pub mod reference;
 pub mod scene;
 pub mod scenes;
 pub mod step;

@@ -1,0 +1,312 @@
+//! Narrowphase reference (twin of `shaders/narrowphase.wgsl`): contact
+//! manifolds between boxes and spheres.
+//!
+//! A manifold has one normal `n`, pointing from the first shape to the
+//! second, and up to `MAX_POINTS` pairs of points (`on_a`, `on_b`) in world
+//! space. Its separation `dot(on_b - on_a, n)` is negative where the shapes
+//! overlap; pairs up to `margin` apart are kept too (speculative contacts).
+
+use glam::{Mat3, Quat, Vec3};
+
+/// Points kept per pair: the clipped polygon (up to 8) is reduced to 4.
+pub const MAX_POINTS: usize = 4;
+
+/// A box or sphere placed in the world.
+#[derive(Clone, Copy, Debug)]
+pub struct Placed {
+    pub centre: Vec3,
+    pub rot: Quat,
+    pub shape: ShapeKind,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum ShapeKind {
+    Box(Vec3),
+    Sphere(f32),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint {
+    pub on_a: Vec3,
+    pub on_b: Vec3,
+}
+
+impl ContactPoint {
+    pub fn separation(&self, n: Vec3) -> f32 {
+        (self.on_b - self.on_a).dot(n)
+    }
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Manifold {
+    pub normal: Vec3,
+    pub points: Vec<ContactPoint>,
+}
+
+/// An edge axis must beat the best face axis by this much (m) to be chosen:
+/// faces give stable multi-point manifolds, edges one point (Box2D prefers
+/// faces by its linear slop, 5 mm, likewise). Depths can thus exceed the
+/// true overlap by at most this.
+pub const EDGE_BIAS: f32 = 0.005;
+
+/// The manifold between `a` and `b`, or None when they are more than
+/// `margin` apart.
+pub fn collide(a: &Placed, b: &Placed, margin: f32) -> Option<Manifold> {
+    match (a.shape, b.shape) {
+        (ShapeKind::Sphere(ra), ShapeKind::Sphere(rb)) => sphere_sphere(a.centre, ra, b.centre, rb, margin),
+        (ShapeKind::Box(h), ShapeKind::Sphere(r)) => box_sphere(a.centre, a.rot, h, b.centre, r, margin),
+        (ShapeKind::Sphere(r), ShapeKind::Box(h)) => {
+            box_sphere(b.centre, b.rot, h, a.centre, r, margin).map(|m| flip(&m))
+        }
+        (ShapeKind::Box(ha), ShapeKind::Box(hb)) => box_box(a.centre, a.rot, ha, b.centre, b.rot, hb, margin),
+    }
+}
+
+fn flip(m: &Manifold) -> Manifold {
+    Manifold {
+        normal: -m.normal,
+        points: m.points.iter().map(|p| ContactPoint { on_a: p.on_b, on_b: p.on_a }).collect(),
+    }
+}
+
+pub fn sphere_sphere(ca: Vec3, ra: f32, cb: Vec3, rb: f32, margin: f32) -> Option<Manifold> {
+    let d = cb - ca;
+    let dist = d.length();
+    if dist - ra - rb > margin {
+        return None;
+    }
+    let n = if dist > 1e-6 { d / dist } else { Vec3::Y };
+    Some(Manifold { normal: n, points: vec![ContactPoint { on_a: ca + n * ra, on_b: cb - n * rb }] })
+}
+
+/// Box first, sphere second: the normal points from the box to the sphere.
+pub fn box_sphere(cb: Vec3, rot: Quat, h: Vec3, cs: Vec3, r: f32, margin: f32) -> Option<Manifold> {
+    let local = rot.conjugate() * (cs - cb);
+    let closest = local.clamp(-h, h);
+    let outside = local - closest;
+    let dist = outside.length();
+    let (n_local, on_box_local) = if dist > 1e-6 {
+        (outside / dist, closest)
+    } else {
+        // centre inside the box: leave through the nearest face
+        let room = h - local.abs();
+        let k = if room.x <= room.y && room.x <= room.z { 0 } else if room.y <= room.z { 1 } else { 2 };
+        let sign = if local[k] >= 0.0 { 1.0 } else { -1.0 };
+        let mut n = Vec3::ZERO;
+        n[k] = sign;
+        let mut p = local;
+        p[k] = sign * h[k];
+        (n, p)
+    };
+    let n = rot * n_local;
+    let on_box = cb + rot * on_box_local;
+    let on_sphere = cs - n * r;
+    if (on_sphere - on_box).dot(n) > margin {
+        return None;
+    }
+    Some(Manifold { normal: n, points: vec![ContactPoint { on_a: on_box, on_b: on_sphere }] })
+}
+
+/// Separating axes, then clipping of the incident face against the
+/// reference face's sides, reduced to at most four points.
+pub fn box_box(ca: Vec3, qa: Quat, ha: Vec3, cb: Vec3, qb: Quat, hb: Vec3, margin: f32) -> Option<Manifold> {
+    let ra = Mat3::from_quat(qa);
+    let rb = Mat3::from_quat(qb);
+    let axes_a = [ra.x_axis, ra.y_axis, ra.z_axis];
+    let axes_b = [rb.x_axis, rb.y_axis, rb.z_axis];
+    let d = cb - ca;
+    let proj = |axes: &[Vec3; 3], h: Vec3, l: Vec3| h.x * axes[0].dot(l).abs() + h.y * axes[1].dot(l).abs() + h.z * axes[2].dot(l).abs();
+    // separation along an axis (unit), and the axis turned to point from a to b
+    let test = |l: Vec3| {
+        let s = d.dot(l);
+        let sep = s.abs() - proj(&axes_a, ha, l) - proj(&axes_b, hb, l);
+        (sep, if s < 0.0 { -l } else { l })
+    };
+
+    // face axes of a (0..3) and b (3..6)
+    let mut best_face = (f32::MIN, Vec3::ZERO, 0usize);
+    for k in 0..6 {
+        let axis = if k < 3 { axes_a[k] } else { axes_b[k - 3] };
+        let (sep, l) = test(axis);
+        if sep > margin {
+            return None;
+        }
+        if sep > best_face.0 {
+            best_face = (sep, l, k);
+        }
+    }
+    // edge axes
+    let mut best_edge = (f32::MIN, Vec3::ZERO, 0usize, 0usize);
+    for i in 0..3 {
+        for j in 0..3 {
+            let c = axes_a[i].cross(axes_b[j]);
+            let len = c.length();
+            if len < 1e-5 {
+                continue; // parallel edges: the face axes cover it
+            }
+            let (sep, l) = test(c / len);
+            if sep > margin {
+                return None;
+            }
+            if sep > best_edge.0 {
+                best_edge = (sep, l, i, j);
+            }
+        }
+    }
+
+    if best_edge.0 > best_face.0 + EDGE_BIAS {
+        let (_, n, i, j) = best_edge;
+        // the edge of a farthest along n, the edge of b farthest along -n
+        let mut pa = ca;
+        let mut pb = cb;
+        for k in 0..3 {
+            if k != i {
+                pa += axes_a[k] * (ha[k] * axes_a[k].dot(n).signum());
+            }
+            if k != j {
+                pb -= axes_b[k] * (hb[k] * axes_b[k].dot(n).signum());
+            }
+        }
+        let (on_a, on_b) = closest_on_edges(pa, axes_a[i], ha[i], pb, axes_b[j], hb[j]);
+        return Some(Manifold { normal: n, points: vec![ContactPoint { on_a, on_b }] });
+    }
+
+    let (_, n, k) = best_face;
+    // reference box owns the face; incident box is the other, n points ref -> inc
+    let (ref_c, ref_axes, ref_h, inc_c, inc_axes, inc_h, ref_n, flipped) = if k < 3 {
+        (ca, axes_a, ha, cb, axes_b, hb, n, false)
+    } else {
+        (cb, axes_b, hb, ca, axes_a, ha, -n, true)
+    };
+    let face = k % 3;
+    // incident face: the face of the incident box most anti-parallel to ref_n
+    let mut inc_face = 0;
+    let mut most = f32::MAX;
+    for m in 0..3 {
+        let dp = inc_axes[m].dot(ref_n);
+        if -dp.abs() < most {
+            most = -dp.abs();
+            inc_face = m;
+        }
+    }
+    let inc_sign = -inc_axes[inc_face].dot(ref_n).signum();
+    let inc_centre = inc_c + inc_axes[inc_face] * (inc_h[inc_face] * inc_sign);
+    let (u, v) = ((inc_face + 1) % 3, (inc_face + 2) % 3);
+    let (eu, ev) = (inc_axes[u] * inc_h[u], inc_axes[v] * inc_h[v]);
+    let mut poly = vec![inc_centre + eu + ev, inc_centre - eu + ev, inc_centre - eu - ev, inc_centre + eu - ev];
+
+    // clip against the four side planes of the reference face
+    let ref_centre = ref_c + ref_n * ref_h[face];
+    for side in [(face + 1) % 3, (face + 2) % 3] {
+        for sign in [1.0f32, -1.0] {
+            let plane_n = ref_axes[side] * sign;
+            let offset = plane_n.dot(ref_c) + ref_h[side];
+            poly = clip(&poly, plane_n, offset);
+        }
+    }
+    // keep points within the margin of the reference face
+    let mut points: Vec<ContactPoint> = Vec::with_capacity(8);
+    for p in poly {
+        let sep = (p - ref_centre).dot(ref_n);
+        if sep <= margin {
+            let on_ref = p - ref_n * sep;
+            points.push(if flipped { ContactPoint { on_a: p, on_b: on_ref } } else { ContactPoint { on_a: on_ref, on_b: p } });
+        }
+    }
+    if points.is_empty() {
+        return None;
+    }
+    let points = reduce(points, n);
+    Some(Manifold { normal: n, points })
+}
+
+/// Sutherland-Hodgman: the part of `poly` with dot(p, n) <= offset.
+fn clip(poly: &[Vec3], n: Vec3, offset: f32) -> Vec<Vec3> {
+    let mut out = Vec::with_capacity(8);
+    for i in 0..poly.len() {
+        let p = poly[i];
+        let q = poly[(i + 1) % poly.len()];
+        let dp = p.dot(n) - offset;
+        let dq = q.dot(n) - offset;
+        if dp <= 0.0 {
+            out.push(p);
+        }
+        if (dp <= 0.0) != (dq <= 0.0) {
+            out.push(p + (q - p) * (dp / (dp - dq)));
+        }
+    }
+    out
+}
+
+/// Closest points of two segments, each given by centre, unit direction and half length.
+fn closest_on_edges(pa: Vec3, da: Vec3, la: f32, pb: Vec3, db: Vec3, lb: f32) -> (Vec3, Vec3) {
+    let r = pb - pa;
+    let b = da.dot(db);
+    let denom = 1.0 - b * b;
+    let (ra, rb) = (da.dot(r), db.dot(r));
+    let mut s = if denom > 1e-8 { (ra - b * rb) / denom } else { 0.0 };
+    s = s.clamp(-la, la);
+    let mut t = (b * s - rb).clamp(-lb, lb);
+    s = (b * t + ra).clamp(-la, la);
+    t = (b * s - rb).clamp(-lb, lb);
+    (pa + da * s, pb + db * t)
+}
+
+/// At most four points that keep the deepest one and span the most area.
+fn reduce(points: Vec<ContactPoint>, n: Vec3) -> Vec<ContactPoint> {
+    if points.len() <= MAX_POINTS {
+        return points;
+    }
+    let sep = |p: &ContactPoint| p.separation(n);
+    let pos = |p: &ContactPoint| p.on_b;
+    // 1: deepest
+    let mut chosen = [0usize; 4];
+    for (i, p) in points.iter().enumerate() {
+        if sep(p) < sep(&points[chosen[0]]) {
+            chosen[0] = i;
+        }
+    }
+    // 2: farthest from it
+    let p0 = pos(&points[chosen[0]]);
+    let mut best = -1.0;
+    for (i, p) in points.iter().enumerate() {
+        let d = (pos(p) - p0).length_squared();
+        if d > best {
+            best = d;
+            chosen[1] = i;
+        }
+    }
+    // 3: largest triangle; 4: largest area added on the other side
+    let p1 = pos(&points[chosen[1]]);
+    let mut best = f32::MIN;
+    for (i, p) in points.iter().enumerate() {
+        let area = (p1 - p0).cross(pos(p) - p0).dot(n);
+        if area.abs() > best {
+            best = area.abs();
+            chosen[2] = i;
+        }
+    }
+    let p2 = pos(&points[chosen[2]]);
+    let side = (p1 - p0).cross(p2 - p0).dot(n).signum();
+    let mut best = f32::MIN;
+    chosen[3] = chosen[0];
+    for (i, p) in points.iter().enumerate() {
+        let q = pos(p);
+        // area added outside the triangle, seen along n
+        let added = [(p0, p1), (p1, p2), (p2, p0)]
+            .iter()
+            .map(|(e0, e1)| -side * (*e1 - *e0).cross(q - *e0).dot(n))
+            .fold(f32::MIN, f32::max);
+        if added > best {
+            best = added;
+            chosen[3] = i;
+        }
+    }
+    let mut out: Vec<ContactPoint> = Vec::with_capacity(4);
+    for &i in &chosen {
+        if !out.contains(&points[i]) {
+            out.push(points[i]);
+        }
+    }
+    out
+}
