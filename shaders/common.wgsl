@@ -38,10 +38,32 @@ struct Params {
     has_ground: u32,         // 1 if the ground plane exists
     ground_restitution: f32, // the ground's material (settings.restitution)
     ground_friction: f32,    // the ground's material (settings.friction)
+    cell_size: f32,          // edge of a broadphase grid cell (m)
+    hash_size: u32,          // buckets of the grid's hash table (a power of two)
+    large_count: u32,        // bodies too large for the grid (see large[])
+    speculative: f32,        // farthest gap (m) at which grid pairs get contacts
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
 }
+
+// One contact point of a body, stored in the body's own slots: the point on
+// the body and the matching point on its partner, each in its owner's frame,
+// and the world normal along which this body is pushed out. 48 bytes.
+struct Contact {
+    local_self: vec3<f32>,
+    partner: u32,            // body index; NO_BODY never appears in a stored contact
+    local_partner: vec3<f32>,
+    _pad0: u32,
+    normal: vec3<f32>,       // unit, world frame, pointing from the partner to this body
+    _pad1: u32,
+}
+
+// Contact points a body can hold per step (a full list is reported, never
+// silent): a unit box in a pile touches about six neighbours with up to four
+// points each.
+const MAX_CONTACTS: u32 = 24u;
+const NO_BODY: u32 = 0xffffffffu;
 
 const SHAPE_BOX: u32 = 0u;
 const SHAPE_SPHERE: u32 = 1u;

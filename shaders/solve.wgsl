@@ -41,6 +41,42 @@ fn solve_ground_point(s: ptr<function, BodyState>, p: BodyProps, k: u32) {
     snap(s, p, r_now, -t, undo / effective_inv_mass(p, (*s).rot, r_now, t));
 }
 
+// One contact with another body, which sits still at its state_in pose
+// while this body moves (Jacobi): this body takes its share of the snap,
+// w_self / (w_self + w_partner), and the partner takes the rest in its own
+// thread from the mirrored contact.
+fn solve_pair_contact(s: ptr<function, BodyState>, p: BodyProps, c: Contact) {
+    let o = state_in[c.partner];
+    let q = props[c.partner];
+    let n = c.normal;
+    let r = quat_rotate((*s).rot, c.local_self);
+    let r_o = quat_rotate(o.rot, c.local_partner);
+    let point_o = o.pos.xyz + r_o;
+    let depth = dot(point_o - ((*s).pos.xyz + r), n);
+    if (depth <= 0.0) {
+        return;
+    }
+    let w_o = effective_inv_mass(q, o.rot, r_o, n);
+    let normal_push = depth * params.relaxation;
+    snap(s, p, r, n, normal_push / (effective_inv_mass(p, (*s).rot, r, n) + w_o));
+
+    // friction: relative sliding of the two material points since their previous poses
+    let r_now = quat_rotate((*s).rot, c.local_self);
+    let slip_self = ((*s).pos.xyz + r_now) - ((*s).prev_pos.xyz + quat_rotate((*s).prev_rot, c.local_self));
+    let slip_o = point_o - (o.prev_pos.xyz + quat_rotate(o.prev_rot, c.local_partner));
+    let slip = slip_self - slip_o;
+    let slip_t = slip - n * dot(slip, n);
+    let slide = length(slip_t);
+    if (slide < 1e-9) {
+        return;
+    }
+    let t = slip_t / slide;
+    let mu = sqrt(p.material.y * q.material.y);
+    let undo = min(slide, mu * normal_push);
+    let w_t = effective_inv_mass(p, (*s).rot, r_now, t) + effective_inv_mass(q, o.rot, r_o, t);
+    snap(s, p, r_now, -t, undo / w_t);
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -49,10 +85,16 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var s = state_in[i];
     let p = props[i];
-    if (!is_fixed(p) && params.has_ground != 0u) {
-        let count = ground_point_count(p);
-        for (var k = 0u; k < count; k = k + 1u) {
-            solve_ground_point(&s, p, k);
+    if (!is_fixed(p)) {
+        if (params.has_ground != 0u) {
+            let count = ground_point_count(p);
+            for (var k = 0u; k < count; k = k + 1u) {
+                solve_ground_point(&s, p, k);
+            }
+        }
+        let contacts_here = contact_count[i];
+        for (var k = 0u; k < contacts_here; k = k + 1u) {
+            solve_pair_contact(&s, p, contacts[i * MAX_CONTACTS + k]);
         }
     }
     state_out[i] = s;

@@ -39,9 +39,11 @@ fn shared_structs_match_member_by_member() {
         common,
         Params {
             gravity, dt, dt_prev, relaxation, linear_damping, angular_damping, body_count, has_ground,
-            ground_restitution, ground_friction, _pad0, _pad1, _pad2
+            ground_restitution, ground_friction, cell_size, hash_size, large_count, speculative,
+            _pad0, _pad1, _pad2
         }
     );
+    check_layout!(common, Contact { local_self, partner, local_partner, _pad0, normal, _pad1 });
 }
 
 #[test]
@@ -58,4 +60,9 @@ fn constants_match() {
     assert_eq!(find("SHAPE_SPHERE"), SHAPE_SPHERE);
     assert_eq!(find("FLAG_FIXED"), FLAG_FIXED);
     assert_eq!(find("WORKGROUP"), WORKGROUP);
+    assert_eq!(find("MAX_CONTACTS"), MAX_CONTACTS);
+    let grid = format!("{}{}{}", shaders::COMMON, shaders::BINDINGS, shaders::GRID);
+    let module = shaders::validate(&grid).unwrap();
+    let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some("SCAN_BLOCK")).unwrap();
+    assert!(matches!(module.global_expressions[c.init], naga::Expression::Literal(naga::Literal::U32(SCAN_BLOCK))));
 }

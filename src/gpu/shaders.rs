@@ -4,13 +4,26 @@
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
 pub const BINDINGS: &str = include_str!("../../shaders/bindings.wgsl");
 pub const GROUND: &str = include_str!("../../shaders/ground.wgsl");
+pub const GRID: &str = include_str!("../../shaders/grid.wgsl");
+pub const COLLIDE: &str = include_str!("../../shaders/collide.wgsl");
+pub const NARROWPHASE: &str = include_str!("../../shaders/narrowphase.wgsl");
 pub const INTEGRATE: &str = include_str!("../../shaders/integrate.wgsl");
 pub const SOLVE: &str = include_str!("../../shaders/solve.wgsl");
 pub const RESTITUTION: &str = include_str!("../../shaders/restitution.wgsl");
 
-/// Every compute pass: its entry point (named like the pass and its file)
-/// and the pieces of its module, in order.
+const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
+
+/// Every compute pass: its entry point (named like the pass; grid passes
+/// live together in grid.wgsl) and the pieces of its module, in order.
 pub const PASSES: &[(&str, &[&str])] = &[
+    ("grid_clear", GRID_PASS),
+    ("grid_count", GRID_PASS),
+    ("grid_scan_blocks", GRID_PASS),
+    ("grid_scan_sums", GRID_PASS),
+    ("grid_scan_add", GRID_PASS),
+    ("grid_scatter", GRID_PASS),
+    ("grid_sort", GRID_PASS),
+    ("narrowphase", &[COMMON, BINDINGS, GRID, COLLIDE, NARROWPHASE]),
     ("integrate", &[COMMON, BINDINGS, INTEGRATE]),
     ("solve", &[COMMON, BINDINGS, GROUND, SOLVE]),
     ("restitution", &[COMMON, BINDINGS, GROUND, RESTITUTION]),

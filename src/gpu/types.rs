@@ -40,7 +40,7 @@ pub struct Velocity {
     pub angular: [f32; 4],
 }
 
-/// Per-step parameters (64 bytes, stored in 256-byte slots).
+/// Per-step parameters (80 bytes, stored in 256-byte slots).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Params {
@@ -55,14 +55,41 @@ pub struct Params {
     pub has_ground: u32,
     pub ground_restitution: f32,
     pub ground_friction: f32,
+    /// Edge of a broadphase cell (m).
+    pub cell_size: f32,
+    /// Buckets of the grid's hash table (a power of two).
+    pub hash_size: u32,
+    /// Bodies in the `large` list, outside the grid.
+    pub large_count: u32,
+    /// Farthest gap (m) at which pairs found through the grid get contacts.
+    pub speculative: f32,
     pub _pad0: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }
 
+/// One contact point held by a body (48 bytes); see `Contact` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Contact {
+    pub local_self: [f32; 3],
+    pub partner: u32,
+    pub local_partner: [f32; 3],
+    pub _pad0: u32,
+    pub normal: [f32; 3],
+    pub _pad1: u32,
+}
+
+/// Contact slots per body (`MAX_CONTACTS` in WGSL).
+pub const MAX_CONTACTS: u32 = 24;
+/// Buckets summed per workgroup by the grid scan (`SCAN_BLOCK` in WGSL).
+pub const SCAN_BLOCK: u32 = 256;
+
 pub const SHAPE_BOX: u32 = 0;
 pub const SHAPE_SPHERE: u32 = 1;
 pub const FLAG_FIXED: u32 = 1;
+/// `BodyProps::kind[2]` of a body too large for the grid.
+pub const LARGE: u32 = 1;
 
 /// Threads per workgroup of every per-body pass (`WORKGROUP` in WGSL).
 pub const WORKGROUP: u32 = 64;

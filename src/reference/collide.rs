@@ -302,9 +302,10 @@ fn reduce(points: Vec<ContactPoint>, n: Vec3) -> Vec<ContactPoint> {
             chosen[3] = i;
         }
     }
+    // distinct choices only, in the order chosen
     let mut out: Vec<ContactPoint> = Vec::with_capacity(4);
-    for &i in &chosen {
-        if !out.contains(&points[i]) {
+    for (c, &i) in chosen.iter().enumerate() {
+        if !chosen[..c].contains(&i) {
             out.push(points[i]);
         }
     }

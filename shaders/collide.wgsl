@@ -1,0 +1,387 @@
+// Contact manifolds between boxes and spheres: the twin of
+// src/reference/collide.rs, step for step. A manifold's normal points from
+// the first shape to the second; its points come in pairs (on_a, on_b) whose
+// separation dot(on_b - on_a, n) is negative where the shapes overlap.
+
+const MAX_POINTS: u32 = 4u;
+// An edge axis must beat the best face axis by this much (m) to be chosen.
+const EDGE_BIAS: f32 = 0.005;
+
+struct Shape {
+    centre: vec3<f32>,
+    rot: vec4<f32>,
+    half: vec3<f32>, // box half extents; sphere: radius in x
+    kind: u32,
+}
+
+struct Manifold {
+    normal: vec3<f32>,
+    count: u32,
+    on_a: array<vec3<f32>, 4>,
+    on_b: array<vec3<f32>, 4>,
+}
+
+fn empty_manifold() -> Manifold {
+    var m: Manifold;
+    m.count = 0u;
+    m.normal = vec3<f32>(0.0, 1.0, 0.0);
+    return m;
+}
+
+fn sphere_sphere(ca: vec3<f32>, ra: f32, cb: vec3<f32>, rb: f32, margin: f32) -> Manifold {
+    var m = empty_manifold();
+    let d = cb - ca;
+    let dist = length(d);
+    if (dist - ra - rb > margin) {
+        return m;
+    }
+    var n = vec3<f32>(0.0, 1.0, 0.0);
+    if (dist > 1e-6) {
+        n = d / dist;
+    }
+    m.normal = n;
+    m.count = 1u;
+    m.on_a[0] = ca + n * ra;
+    m.on_b[0] = cb - n * rb;
+    return m;
+}
+
+// Box first, sphere second.
+fn box_sphere(cb: vec3<f32>, rot: vec4<f32>, h: vec3<f32>, cs: vec3<f32>, r: f32, margin: f32) -> Manifold {
+    var m = empty_manifold();
+    let local = quat_rotate(quat_conj(rot), cs - cb);
+    let closest = clamp(local, -h, h);
+    let outside = local - closest;
+    let dist = length(outside);
+    var n_local: vec3<f32>;
+    var on_box_local: vec3<f32>;
+    if (dist > 1e-6) {
+        n_local = outside / dist;
+        on_box_local = closest;
+    } else {
+        // centre inside the box: leave through the nearest face
+        let room = h - abs(local);
+        var k = 2u;
+        if (room.x <= room.y && room.x <= room.z) {
+            k = 0u;
+        } else if (room.y <= room.z) {
+            k = 1u;
+        }
+        let sign = select(-1.0, 1.0, local[k] >= 0.0);
+        n_local = vec3<f32>(0.0);
+        n_local[k] = sign;
+        on_box_local = local;
+        on_box_local[k] = sign * h[k];
+    }
+    let n = quat_rotate(rot, n_local);
+    let on_box = cb + quat_rotate(rot, on_box_local);
+    let on_sphere = cs - n * r;
+    if (dot(on_sphere - on_box, n) > margin) {
+        return m;
+    }
+    m.normal = n;
+    m.count = 1u;
+    m.on_a[0] = on_box;
+    m.on_b[0] = on_sphere;
+    return m;
+}
+
+fn flip_manifold(m_in: Manifold) -> Manifold {
+    var m = m_in;
+    m.normal = -m_in.normal;
+    for (var k = 0u; k < m_in.count; k = k + 1u) {
+        m.on_a[k] = m_in.on_b[k];
+        m.on_b[k] = m_in.on_a[k];
+    }
+    return m;
+}
+
+fn box_axes(q: vec4<f32>) -> array<vec3<f32>, 3> {
+    return array<vec3<f32>, 3>(
+        quat_rotate(q, vec3<f32>(1.0, 0.0, 0.0)),
+        quat_rotate(q, vec3<f32>(0.0, 1.0, 0.0)),
+        quat_rotate(q, vec3<f32>(0.0, 0.0, 1.0)),
+    );
+}
+
+fn project_box(axes: array<vec3<f32>, 3>, h: vec3<f32>, l: vec3<f32>) -> f32 {
+    return h.x * abs(dot(axes[0], l)) + h.y * abs(dot(axes[1], l)) + h.z * abs(dot(axes[2], l));
+}
+
+fn sign_of(x: f32) -> f32 {
+    // like Rust's f32::signum: +1 for +0
+    return select(-1.0, 1.0, x >= 0.0);
+}
+
+// Closest points of two segments (centre, unit direction, half length).
+fn closest_on_edges(pa: vec3<f32>, da: vec3<f32>, la: f32, pb: vec3<f32>, db: vec3<f32>, lb: f32,
+                    out_a: ptr<function, vec3<f32>>, out_b: ptr<function, vec3<f32>>) {
+    let r = pb - pa;
+    let b = dot(da, db);
+    let denom = 1.0 - b * b;
+    let ra = dot(da, r);
+    let rb = dot(db, r);
+    var s = 0.0;
+    if (denom > 1e-8) {
+        s = (ra - b * rb) / denom;
+    }
+    s = clamp(s, -la, la);
+    var t = clamp(b * s - rb, -lb, lb);
+    s = clamp(b * t + ra, -la, la);
+    t = clamp(b * s - rb, -lb, lb);
+    *out_a = pa + da * s;
+    *out_b = pb + db * t;
+}
+
+var<private> poly: array<vec3<f32>, 8>;
+var<private> poly_len: u32;
+
+// Sutherland-Hodgman: keep the part of the polygon with dot(p, n) <= offset.
+fn clip_poly(n: vec3<f32>, offset: f32) {
+    var out: array<vec3<f32>, 8>;
+    var len = 0u;
+    for (var i = 0u; i < poly_len; i = i + 1u) {
+        let p = poly[i];
+        let q = poly[(i + 1u) % poly_len];
+        let dp = dot(p, n) - offset;
+        let dq = dot(q, n) - offset;
+        if (dp <= 0.0 && len < 8u) {
+            out[len] = p;
+            len = len + 1u;
+        }
+        if ((dp <= 0.0) != (dq <= 0.0) && len < 8u) {
+            out[len] = p + (q - p) * (dp / (dp - dq));
+            len = len + 1u;
+        }
+    }
+    poly = out;
+    poly_len = len;
+}
+
+fn box_box(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, margin: f32) -> Manifold {
+    var m = empty_manifold();
+    let axes_a = box_axes(qa);
+    let axes_b = box_axes(qb);
+    let d = cb - ca;
+
+    // face axes of a (0..3) and b (3..6)
+    var best_face_sep = -3.4e38;
+    var best_face_n = vec3<f32>(0.0);
+    var best_face = 0u;
+    for (var k = 0u; k < 6u; k = k + 1u) {
+        var axis: vec3<f32>;
+        if (k < 3u) {
+            axis = axes_a[k];
+        } else {
+            axis = axes_b[k - 3u];
+        }
+        let s = dot(d, axis);
+        let sep = abs(s) - project_box(axes_a, ha, axis) - project_box(axes_b, hb, axis);
+        if (sep > margin) {
+            return m;
+        }
+        if (sep > best_face_sep) {
+            best_face_sep = sep;
+            best_face_n = select(axis, -axis, s < 0.0);
+            best_face = k;
+        }
+    }
+    // edge axes
+    var best_edge_sep = -3.4e38;
+    var best_edge_n = vec3<f32>(0.0);
+    var edge_i = 0u;
+    var edge_j = 0u;
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        for (var j = 0u; j < 3u; j = j + 1u) {
+            let c = cross(axes_a[i], axes_b[j]);
+            let len = length(c);
+            if (len < 1e-5) {
+                continue;
+            }
+            let axis = c / len;
+            let s = dot(d, axis);
+            let sep = abs(s) - project_box(axes_a, ha, axis) - project_box(axes_b, hb, axis);
+            if (sep > margin) {
+                return m;
+            }
+            if (sep > best_edge_sep) {
+                best_edge_sep = sep;
+                best_edge_n = select(axis, -axis, s < 0.0);
+                edge_i = i;
+                edge_j = j;
+            }
+        }
+    }
+
+    if (best_edge_sep > best_face_sep + EDGE_BIAS) {
+        let n = best_edge_n;
+        // the edge of a farthest along n, the edge of b farthest along -n
+        var pa = ca;
+        var pb = cb;
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            if (k != edge_i) {
+                pa = pa + axes_a[k] * (ha[k] * sign_of(dot(axes_a[k], n)));
+            }
+            if (k != edge_j) {
+                pb = pb - axes_b[k] * (hb[k] * sign_of(dot(axes_b[k], n)));
+            }
+        }
+        var on_a: vec3<f32>;
+        var on_b: vec3<f32>;
+        closest_on_edges(pa, axes_a[edge_i], ha[edge_i], pb, axes_b[edge_j], hb[edge_j], &on_a, &on_b);
+        m.normal = n;
+        m.count = 1u;
+        m.on_a[0] = on_a;
+        m.on_b[0] = on_b;
+        return m;
+    }
+
+    // reference box owns the face; n_ref points from it to the incident box
+    let n = best_face_n;
+    let flipped = best_face >= 3u;
+    let face = best_face % 3u;
+    var ref_c = ca;
+    var ref_axes = axes_a;
+    var ref_h = ha;
+    var inc_c = cb;
+    var inc_axes = axes_b;
+    var inc_h = hb;
+    var ref_n = n;
+    if (flipped) {
+        ref_c = cb;
+        ref_axes = axes_b;
+        ref_h = hb;
+        inc_c = ca;
+        inc_axes = axes_a;
+        inc_h = ha;
+        ref_n = -n;
+    }
+    // incident face: the face of the incident box most anti-parallel to ref_n
+    var inc_face = 0u;
+    var most = 3.4e38;
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        let v = -abs(dot(inc_axes[k], ref_n));
+        if (v < most) {
+            most = v;
+            inc_face = k;
+        }
+    }
+    let inc_sign = -sign_of(dot(inc_axes[inc_face], ref_n));
+    let inc_centre = inc_c + inc_axes[inc_face] * (inc_h[inc_face] * inc_sign);
+    let u = (inc_face + 1u) % 3u;
+    let v = (inc_face + 2u) % 3u;
+    let eu = inc_axes[u] * inc_h[u];
+    let ev = inc_axes[v] * inc_h[v];
+    poly[0] = inc_centre + eu + ev;
+    poly[1] = inc_centre - eu + ev;
+    poly[2] = inc_centre - eu - ev;
+    poly[3] = inc_centre + eu - ev;
+    poly_len = 4u;
+
+    // clip against the four side planes of the reference face
+    let ref_centre = ref_c + ref_n * ref_h[face];
+    for (var e = 1u; e < 3u; e = e + 1u) {
+        let side = (face + e) % 3u;
+        for (var sgn = 0u; sgn < 2u; sgn = sgn + 1u) {
+            let plane_n = ref_axes[side] * select(-1.0, 1.0, sgn == 0u);
+            clip_poly(plane_n, dot(plane_n, ref_c) + ref_h[side]);
+        }
+    }
+    // keep points within the margin of the reference face
+    var pts_a: array<vec3<f32>, 8>;
+    var pts_b: array<vec3<f32>, 8>;
+    var count = 0u;
+    for (var k = 0u; k < poly_len; k = k + 1u) {
+        let p = poly[k];
+        let sep = dot(p - ref_centre, ref_n);
+        if (sep <= margin) {
+            let on_ref = p - ref_n * sep;
+            if (flipped) {
+                pts_a[count] = p;
+                pts_b[count] = on_ref;
+            } else {
+                pts_a[count] = on_ref;
+                pts_b[count] = p;
+            }
+            count = count + 1u;
+        }
+    }
+    m.normal = n;
+    if (count <= MAX_POINTS) {
+        m.count = count;
+        for (var k = 0u; k < count; k = k + 1u) {
+            m.on_a[k] = pts_a[k];
+            m.on_b[k] = pts_b[k];
+        }
+        return m;
+    }
+    // reduce to four: the deepest, the farthest from it, the largest
+    // triangle, the largest area added outside that triangle
+    var chosen = array<u32, 4>(0u, 0u, 0u, 0u);
+    for (var k = 0u; k < count; k = k + 1u) {
+        if (dot(pts_b[k] - pts_a[k], n) < dot(pts_b[chosen[0]] - pts_a[chosen[0]], n)) {
+            chosen[0] = k;
+        }
+    }
+    let p0 = pts_b[chosen[0]];
+    var best = -1.0;
+    for (var k = 0u; k < count; k = k + 1u) {
+        let dd = dot(pts_b[k] - p0, pts_b[k] - p0);
+        if (dd > best) {
+            best = dd;
+            chosen[1] = k;
+        }
+    }
+    let p1 = pts_b[chosen[1]];
+    best = -3.4e38;
+    for (var k = 0u; k < count; k = k + 1u) {
+        let area = abs(dot(cross(p1 - p0, pts_b[k] - p0), n));
+        if (area > best) {
+            best = area;
+            chosen[2] = k;
+        }
+    }
+    let p2 = pts_b[chosen[2]];
+    let side = sign_of(dot(cross(p1 - p0, p2 - p0), n));
+    best = -3.4e38;
+    chosen[3] = chosen[0];
+    for (var k = 0u; k < count; k = k + 1u) {
+        let q = pts_b[k];
+        let added = max(max(-side * dot(cross(p1 - p0, q - p0), n), -side * dot(cross(p2 - p1, q - p1), n)),
+                        -side * dot(cross(p0 - p2, q - p2), n));
+        if (added > best) {
+            best = added;
+            chosen[3] = k;
+        }
+    }
+    // distinct choices only, in the order chosen
+    var out = 0u;
+    for (var c = 0u; c < 4u; c = c + 1u) {
+        var seen = false;
+        for (var e = 0u; e < c; e = e + 1u) {
+            if (chosen[e] == chosen[c]) {
+                seen = true;
+            }
+        }
+        if (!seen) {
+            m.on_a[out] = pts_a[chosen[c]];
+            m.on_b[out] = pts_b[chosen[c]];
+            out = out + 1u;
+        }
+    }
+    m.count = out;
+    return m;
+}
+
+fn collide(a: Shape, b: Shape, margin: f32) -> Manifold {
+    if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_SPHERE) {
+        return sphere_sphere(a.centre, a.half.x, b.centre, b.half.x, margin);
+    }
+    if (a.kind == SHAPE_BOX && b.kind == SHAPE_SPHERE) {
+        return box_sphere(a.centre, a.rot, a.half, b.centre, b.half.x, margin);
+    }
+    if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_BOX) {
+        return flip_manifold(box_sphere(b.centre, b.rot, b.half, a.centre, a.half.x, margin));
+    }
+    return box_box(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
+}
