@@ -15,5 +15,6 @@
 // contacts: MAX_CONTACTS slots per body, filled by the body itself
 @group(0) @binding(10) var<storage, read_write> contacts: array<Contact>;
 @group(0) @binding(11) var<storage, read_write> contact_count: array<u32>;
-// status[0]: most contact points any body wanted this step (overflow if > MAX_CONTACTS)
+// status[0]: most contact points any body wanted this step, status[1]: in any
+// step so far (a full contact list when either exceeds MAX_CONTACTS)
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;

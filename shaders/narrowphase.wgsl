@@ -122,4 +122,5 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     contact_count[i] = self_count;
     atomicMax(&status[0], wanted);
+    atomicMax(&status[1], wanted);
 }

@@ -7,7 +7,7 @@ use glam::{DQuat, DVec3};
 
 use crate::gpu::{types::*, Gpu};
 use crate::scene::{Body, Scene, Settings, Shape};
-use crate::step::{Stage, StepPipelines};
+use crate::step::{Over, Stage, StepPipelines, STORAGE_BUFFERS};
 use crate::Error;
 
 /// Steps encoded into one submission; each gets its own `Params` slot.
@@ -27,20 +27,78 @@ pub struct BodyOutput {
 
 /// The GPU buffers of a world. Nothing here is created after start-up.
 struct WorldData {
-    #[allow(dead_code)]
-    props: wgpu::Buffer,
     states: [wgpu::Buffer; 2],
-    #[allow(dead_code)]
-    vel0: wgpu::Buffer,
     params: wgpu::Buffer,
+    status: wgpu::Buffer,
     /// `bind_groups[k]` reads `states[k]` and writes `states[1 - k]`.
     bind_groups: [wgpu::BindGroup; 2],
+    /// Every other buffer, kept alive for the bind groups.
+    _others: Vec<wgpu::Buffer>,
 }
 
-/// Bytes of GPU memory per body, by buffer.
+/// The broadphase grid's shape, fixed at start-up from the bodies' sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridLayout {
+    /// Edge of a cell (m): two grid bodies that can touch within the
+    /// speculative gap are never more than one cell apart.
+    pub cell_size: f32,
+    /// Buckets of the hash table (a power of two, about two per body).
+    pub hash_size: u32,
+    /// Farthest gap (m) at which grid pairs get contacts.
+    pub speculative: f32,
+}
+
+/// A body whose bounding radius exceeds this many times the median one is
+/// kept out of the grid (a ramp, a wall, a floor made of boxes) and checked
+/// by every body instead, so it never inflates the cells.
+const LARGE_FACTOR: f32 = 2.0;
+/// At most this many bodies are kept out of the grid; beyond it the cells
+/// grow to hold the rest.
+const MAX_LARGE: usize = 256;
+
+/// Which bodies stay out of the grid, and the grid for the rest.
+pub fn plan_grid(radii: &[f32]) -> (Vec<u32>, GridLayout) {
+    let mut sorted: Vec<f32> = radii.to_vec();
+    sorted.sort_by(f32::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.5);
+    let mut large: Vec<u32> = (0..radii.len() as u32).filter(|&i| radii[i as usize] > LARGE_FACTOR * median).collect();
+    if large.len() > MAX_LARGE {
+        large.sort_by(|&a, &b| radii[b as usize].total_cmp(&radii[a as usize]).then(a.cmp(&b)));
+        large.truncate(MAX_LARGE);
+        large.sort();
+    }
+    let is_large = |i: usize| large.binary_search(&(i as u32)).is_ok();
+    let r = (0..radii.len()).filter(|&i| !is_large(i)).map(|i| radii[i]).fold(0.0f32, f32::max).max(1e-3);
+    let speculative = 0.5 * r;
+    let hash_size = (2 * radii.len()).max(1024).next_power_of_two() as u32;
+    (large, GridLayout { cell_size: 2.0 * r + speculative, hash_size, speculative })
+}
+
+/// What the GPU reports about the contact lists.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ContactReport {
+    /// Most contact points one body wanted in the last step.
+    pub last_step_max: u32,
+    /// Most contact points one body wanted in any step so far.
+    pub run_max: u32,
+    /// Points a body can hold; more are dropped (the farthest partners').
+    pub capacity: u32,
+}
+
+impl ContactReport {
+    pub fn overflowed(&self) -> bool {
+        self.run_max > self.capacity
+    }
+}
+
+/// Bytes of GPU memory per body: poses (two buffers), properties, velocities,
+/// contact slots and count, and the grid's share (sorted list, about two
+/// hash buckets with their counts and starts).
 pub fn bytes_per_body() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
-    2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64
+    let contacts = MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64 + 4;
+    let grid = 4 + 2 * 8;
+    2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + contacts + grid
 }
 
 pub struct World {
@@ -49,6 +107,8 @@ pub struct World {
     data: WorldData,
     settings: Settings,
     ground: Option<f32>,
+    grid: GridLayout,
+    large_count: u32,
     body_count: u32,
     /// Which of `data.states` holds the current state.
     current: usize,
@@ -76,17 +136,41 @@ impl World {
         let device = &gpu.device;
         let count = n.max(1); // wgpu buffers may not be empty
 
-        let props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &settings)).collect();
+        let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &settings)).collect();
         let states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &settings)).collect();
-        let props_buf = storage_buffer(&gpu, "props", &props, count, std::mem::size_of::<BodyProps>());
-        let make_state = |label| storage_buffer(&gpu, label, &states, count, std::mem::size_of::<BodyState>());
-        let state_bufs = [make_state("state A"), make_state("state B")];
-        let vel0 = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("vel0"),
-            size: (count * std::mem::size_of::<Velocity>()) as u64,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
+        let radii: Vec<f32> = props.iter().map(|p| p.half_extents[3]).collect();
+        let (large, grid) = plan_grid(&radii);
+        for &i in &large {
+            props[i as usize].kind[2] = LARGE;
+        }
+
+        let storage = |label: &str, size: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let with_data = |label: &str, bytes: &[u8]| {
+            let buf = storage(label, bytes.len() as u64);
+            if !bytes.is_empty() {
+                gpu.queue.write_buffer(&buf, 0, bytes);
+            }
+            buf
+        };
+        let hash = grid.hash_size as u64;
+        let props_buf = with_data("props", bytemuck::cast_slice(&props));
+        let state_bufs = [with_data("state A", bytemuck::cast_slice(&states)), with_data("state B", bytemuck::cast_slice(&states))];
+        let vel0 = storage("vel0", (count * std::mem::size_of::<Velocity>()) as u64);
+        let cell_count = storage("grid/cell_count", 4 * hash);
+        let cell_start = storage("grid/cell_start", 4 * (hash + 1));
+        let block_sums = storage("grid/block_sums", 4 * hash.div_ceil(SCAN_BLOCK as u64));
+        let sorted = storage("grid/sorted", 4 * count as u64);
+        let large_buf = with_data("grid/large", bytemuck::cast_slice(&large));
+        let contacts = storage("contacts", count as u64 * MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64);
+        let contact_count = storage("contact_count", 4 * count as u64);
+        let status = storage("status", 16);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: PARAMS_STRIDE * MAX_BATCH as u64,
@@ -94,28 +178,42 @@ impl World {
             mapped_at_creation: false,
         });
         let pipelines = StepPipelines::new(&gpu);
+        // bindings 1..=12 of shaders/bindings.wgsl, with state_in/state_out per direction
         let bind_group = |from: usize| {
+            let buffers: [&wgpu::Buffer; STORAGE_BUFFERS as usize] = [
+                &props_buf,
+                &state_bufs[from],
+                &state_bufs[1 - from],
+                &vel0,
+                &cell_count,
+                &cell_start,
+                &block_sums,
+                &sorted,
+                &large_buf,
+                &contacts,
+                &contact_count,
+                &status,
+            ];
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                }),
+            }];
+            for (k, buf) in buffers.iter().enumerate() {
+                entries.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: buf.as_entire_binding() });
+            }
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(if from == 0 { "step A->B" } else { "step B->A" }),
                 layout: &pipelines.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &params,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-                        }),
-                    },
-                    wgpu::BindGroupEntry { binding: 1, resource: props_buf.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: state_bufs[from].as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: state_bufs[1 - from].as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: vel0.as_entire_binding() },
-                ],
+                entries: &entries,
             })
         };
         let bind_groups = [bind_group(0), bind_group(1)];
-        let data = WorldData { props: props_buf, states: state_bufs, vel0, params, bind_groups };
+        let others = vec![props_buf, vel0, cell_count, cell_start, block_sums, sorted, large_buf, contacts, contact_count];
+        let data = WorldData { states: state_bufs, params, status, bind_groups, _others: others };
         let substep_dt = settings.dt / settings.substeps as f32;
         Ok(World {
             gpu,
@@ -123,6 +221,8 @@ impl World {
             data,
             settings,
             ground: scene.ground.as_ref().map(|g| g.height),
+            grid,
+            large_count: large.len() as u32,
             body_count: n as u32,
             current: 0,
             step: 0,
@@ -207,6 +307,10 @@ impl World {
                     has_ground: self.ground.is_some() as u32,
                     ground_restitution: s.restitution,
                     ground_friction: s.friction,
+                    cell_size: self.grid.cell_size,
+                    hash_size: self.grid.hash_size,
+                    large_count: self.large_count,
+                    speculative: self.grid.speculative,
                     ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;
@@ -217,35 +321,55 @@ impl World {
         }
         self.gpu.queue.write_buffer(&self.data.params, 0, &slots);
 
-        let groups = self.body_count.div_ceil(WORKGROUP).max(1);
         let mut encoder = self
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("step") });
         for slot in 0..slot {
             let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
-            let mut run = |stage: Stage, current: &mut usize| {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(stage.label()),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(self.pipelines.pipeline(stage));
-                pass.set_bind_group(0, &self.data.bind_groups[*current], &offset);
-                pass.dispatch_workgroups(groups, 1, 1);
-                *current = 1 - *current;
-            };
-            let mut current = self.current;
-            run(Stage::Integrate, &mut current);
-            for _ in 0..self.settings.iterations {
-                run(Stage::Solve, &mut current);
+            for stage in Stage::ALL {
+                let repeats = if stage == Stage::Solve { self.settings.iterations } else { 1 };
+                for _ in 0..repeats {
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(stage.name()),
+                        timestamp_writes: None,
+                    });
+                    pass.set_pipeline(self.pipelines.pipeline(stage));
+                    pass.set_bind_group(0, &self.data.bind_groups[self.current], &offset);
+                    pass.dispatch_workgroups(self.workgroups(stage.over()), 1, 1);
+                    drop(pass);
+                    if stage.flips_state() {
+                        self.current = 1 - self.current;
+                    }
+                }
             }
-            run(Stage::Restitution, &mut current);
-            self.current = current;
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.dt_prev = dt_prev;
         self.step += dts.len() as u64;
         self.time += dts.iter().map(|&d| d as f64).sum::<f64>();
+    }
+
+    fn workgroups(&self, over: Over) -> u32 {
+        let n = match over {
+            Over::Bodies => self.body_count.div_ceil(WORKGROUP),
+            Over::Buckets => self.grid.hash_size.div_ceil(WORKGROUP),
+            Over::ScanBlocks => self.grid.hash_size.div_ceil(SCAN_BLOCK),
+            Over::One => 1,
+        };
+        n.max(1)
+    }
+
+    /// The grid the broadphase uses.
+    pub fn grid(&self) -> GridLayout {
+        self.grid
+    }
+
+    /// How full the contact lists got (a blocking readback).
+    pub fn contact_report(&self) -> Result<ContactReport, Error> {
+        let bytes = self.gpu.read_buffer(&self.data.status, 16)?;
+        let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(ContactReport { last_step_max: v[0], run_max: v[1], capacity: MAX_CONTACTS })
     }
 
     /// Reads every body's pose back and derives its velocities.
@@ -342,31 +466,36 @@ pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
 }
 
 fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
-    let per_binding = gpu.limits.max_storage_buffer_binding_size as u64;
-    let largest = std::mem::size_of::<BodyState>().max(std::mem::size_of::<BodyProps>()) as u64;
-    let max_by_binding = per_binding / largest;
-    let max_by_groups = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
-    let max = max_by_binding.min(max_by_groups);
+    let l = &gpu.limits;
+    if l.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS {
+        return Err(Error::Capacity(format!(
+            "the step binds {STORAGE_BUFFERS} storage buffers per shader stage but this adapter allows {}",
+            l.max_storage_buffers_per_shader_stage
+        )));
+    }
+    let max = max_bodies(gpu);
     if n as u64 > max {
         return Err(Error::Capacity(format!(
-            "the scene has {n} bodies but this adapter holds at most {max} \
-             (storage binding limit {per_binding} bytes at {largest} bytes per body, \
-             {} workgroups of {WORKGROUP} per dispatch)",
-            gpu.limits.max_compute_workgroups_per_dimension
+            "the scene has {n} bodies but this adapter holds at most {max}: each body's contact list takes {} bytes \
+             of one storage buffer, and the adapter binds at most {} bytes",
+            MAX_CONTACTS as usize * std::mem::size_of::<Contact>(),
+            binding_limit(gpu)
         )));
     }
     Ok(())
 }
 
-fn storage_buffer<T: bytemuck::Pod>(gpu: &Gpu, label: &str, data: &[T], count: usize, stride: usize) -> wgpu::Buffer {
-    let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: (count * stride) as u64,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    if !data.is_empty() {
-        gpu.queue.write_buffer(&buf, 0, bytemuck::cast_slice(data));
-    }
-    buf
+fn binding_limit(gpu: &Gpu) -> u64 {
+    (gpu.limits.max_storage_buffer_binding_size as u64).min(gpu.limits.max_buffer_size)
+}
+
+/// The most bodies this GPU can hold: the contact lists must fit one
+/// storage binding, the hash table (up to four buckets per body after
+/// rounding to a power of two) too, and a dispatch has a workgroup limit.
+pub fn max_bodies(gpu: &Gpu) -> u64 {
+    let per_binding = binding_limit(gpu);
+    let by_contacts = per_binding / (MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64);
+    let by_hash = per_binding / 16;
+    let by_groups = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64 / 4;
+    by_contacts.min(by_hash).min(by_groups)
 }

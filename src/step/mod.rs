@@ -1,43 +1,95 @@
 //! The compute pipelines of one step, in the order they run:
 //!
-//! 1. `integrate`   — Verlet prediction of every pose (shaders/integrate.wgsl)
-//! 2. `solve`       — `iterations` Jacobi sweeps of corrective snaps (shaders/solve.wgsl)
-//! 3. `restitution` — bounce, by rewriting the previous pose (shaders/restitution.wgsl)
+//! 1. `grid_*`       — broadphase: counting sort of bodies into a hashed grid (shaders/grid.wgsl)
+//! 2. `narrowphase`  — each body gathers its contacts (shaders/narrowphase.wgsl, collide.wgsl)
+//! 3. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
+//! 4. `solve`        — `iterations` Jacobi sweeps of corrective snaps (shaders/solve.wgsl)
+//! 5. `restitution`  — bounce, by rewriting the previous pose (shaders/restitution.wgsl)
 //!
-//! Every pass reads one state buffer and writes the other, so the current
-//! state flips after each dispatch. This type holds only compiled pipelines
-//! and their layout; the buffers live in `World`.
+//! Passes 1-2 only read the state; 3-5 read one state buffer and write the
+//! other, so the current state flips after each of them. This type holds
+//! only compiled pipelines and their layout; the buffers live in `World`.
 
 use crate::gpu::{shaders, types::*, Gpu};
 
-/// The stages of a step, in order; their names are the WGSL entry points,
-/// the shader files and the labels of their compute passes.
+/// The stages of a step, in order; their names are the WGSL entry points
+/// and the labels of their compute passes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
+    GridClear,
+    GridCount,
+    GridScanBlocks,
+    GridScanSums,
+    GridScanAdd,
+    GridScatter,
+    GridSort,
+    Narrowphase,
     Integrate,
     Solve,
     Restitution,
 }
 
-impl Stage {
-    pub const ALL: [Stage; 3] = [Stage::Integrate, Stage::Solve, Stage::Restitution];
+/// What one invocation of a stage works on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Over {
+    Bodies,
+    Buckets,
+    /// One workgroup of `SCAN_BLOCK` per block of buckets.
+    ScanBlocks,
+    /// A single workgroup.
+    One,
+}
 
+impl Stage {
+    pub const ALL: [Stage; 11] = [
+        Stage::GridClear,
+        Stage::GridCount,
+        Stage::GridScanBlocks,
+        Stage::GridScanSums,
+        Stage::GridScanAdd,
+        Stage::GridScatter,
+        Stage::GridSort,
+        Stage::Narrowphase,
+        Stage::Integrate,
+        Stage::Solve,
+        Stage::Restitution,
+    ];
+
+    /// The WGSL entry point.
     pub fn name(self) -> &'static str {
         match self {
+            Stage::GridClear => "grid_clear",
+            Stage::GridCount => "grid_count",
+            Stage::GridScanBlocks => "grid_scan_blocks",
+            Stage::GridScanSums => "grid_scan_sums",
+            Stage::GridScanAdd => "grid_scan_add",
+            Stage::GridScatter => "grid_scatter",
+            Stage::GridSort => "grid_sort",
+            Stage::Narrowphase => "narrowphase",
             Stage::Integrate => "integrate",
             Stage::Solve => "solve",
             Stage::Restitution => "restitution",
         }
     }
 
-    pub fn label(self) -> &'static str {
+    /// Whether the pass writes state_out (so the current state flips).
+    pub fn flips_state(self) -> bool {
+        matches!(self, Stage::Integrate | Stage::Solve | Stage::Restitution)
+    }
+
+    pub fn over(self) -> Over {
         match self {
-            Stage::Integrate => "step/integrate",
-            Stage::Solve => "step/solve",
-            Stage::Restitution => "step/restitution",
+            Stage::GridClear | Stage::GridScanAdd | Stage::GridSort => Over::Buckets,
+            Stage::GridScanBlocks => Over::ScanBlocks,
+            Stage::GridScanSums => Over::One,
+            _ => Over::Bodies,
         }
     }
 }
+
+/// Storage buffers the step's bind group holds (bindings 1-12 of
+/// shaders/bindings.wgsl); the device must allow this many per stage.
+pub const STORAGE_BUFFERS: u32 = 12;
 
 pub struct StepPipelines {
     pub layout: wgpu::BindGroupLayout,
@@ -61,25 +113,21 @@ impl StepPipelines {
     pub fn new(gpu: &Gpu) -> StepPipelines {
         let device = &gpu.device;
         // shaders/bindings.wgsl
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("step"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-                    },
-                    count: None,
-                },
-                storage(1, true),  // props
-                storage(2, true),  // state_in
-                storage(3, false), // state_out
-                storage(4, false), // vel0
-            ],
-        });
+        let mut entries = vec![wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+            },
+            count: None,
+        }];
+        let read_only = [1, 2, 9]; // props, state_in, large
+        for binding in 1..=STORAGE_BUFFERS {
+            entries.push(storage(binding, read_only.contains(&binding)));
+        }
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("step"), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("step"),
             bind_group_layouts: &[Some(&layout)],
@@ -94,7 +142,7 @@ impl StepPipelines {
                     source: wgpu::ShaderSource::Wgsl(source.into()),
                 });
                 device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(stage.label()),
+                    label: Some(stage.name()),
                     layout: Some(&pipeline_layout),
                     module: &module,
                     entry_point: Some(stage.name()),
