@@ -42,28 +42,34 @@ struct Params {
     hash_size: u32,          // buckets of the grid's hash table (a power of two)
     large_count: u32,        // bodies too large for the grid (see large[])
     speculative: f32,        // farthest gap (m) at which grid pairs get contacts
-    _pad0: u32,
+    substeps: u32,           // substeps per step: contacts found once serve them all
     _pad1: u32,
     _pad2: u32,
 }
 
 // One contact point of a body, stored in the body's own slots: the point on
-// the body and the matching point on its partner, each in its owner's frame,
-// and the world normal along which this body is pushed out. 48 bytes.
+// the body and the matching point on its partner, each in its owner's frame
+// (the ground's in world coordinates), and the world normal along which this
+// body is pushed out. 48 bytes.
 struct Contact {
     local_self: vec3<f32>,
-    partner: u32,            // body index; NO_BODY never appears in a stored contact
+    partner: u32,            // body index, or GROUND
     local_partner: vec3<f32>,
-    _pad0: u32,
+    pushed: f32,             // normal push summed over this step's iterations (m): the friction budget
     normal: vec3<f32>,       // unit, world frame, pointing from the partner to this body
     _pad1: u32,
 }
 
 // Contact points a body can hold per step (a full list is reported, never
-// silent): a unit box in a pile touches about six neighbours with up to four
-// points each.
+// silent): a unit box in a pile touches the ground with four corners and
+// about five neighbours with up to four points each.
 const MAX_CONTACTS: u32 = 24u;
-const NO_BODY: u32 = 0xffffffffu;
+
+// Points closer than this (m) still count as touching when restitution is
+// decided after the solve.
+const CONTACT_SLOP: f32 = 0.002;
+// The partner of a contact with the ground plane.
+const GROUND: u32 = 0xffffffffu;
 
 const SHAPE_BOX: u32 = 0u;
 const SHAPE_SPHERE: u32 = 1u;
@@ -154,4 +160,52 @@ fn inv_inertia_world(q: vec4<f32>, inv_i: vec3<f32>, v: vec3<f32>) -> vec3<f32> 
 
 fn is_fixed(p: BodyProps) -> bool {
     return (p.kind.y & FLAG_FIXED) != 0u;
+}
+
+// Generalised inverse mass of a body for a unit push along dir at offset r.
+fn effective_inv_mass(p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>) -> f32 {
+    let rn = cross(r, dir);
+    return p.inv_inertia.w + dot(rn, inv_inertia_world(rot, p.inv_inertia.xyz, rn));
+}
+
+// The partner's side of a contact at its current pose: its contact point and
+// that point's position at its previous pose. The ground never moves.
+struct PartnerPoint {
+    r: vec3<f32>,      // offset from the partner's centre (zero for the ground)
+    point: vec3<f32>,  // world
+    before: vec3<f32>, // world, at the previous pose
+}
+
+fn partner_point(c: Contact) -> PartnerPoint {
+    if (c.partner == GROUND) {
+        return PartnerPoint(vec3<f32>(0.0), c.local_partner, c.local_partner);
+    }
+    let o = state_in[c.partner];
+    let r = quat_rotate(o.rot, c.local_partner);
+    return PartnerPoint(r, o.pos.xyz + r, o.prev_pos.xyz + quat_rotate(o.prev_rot, c.local_partner));
+}
+
+// The partner's generalised inverse mass along dir (0 for the ground).
+fn partner_inv_mass(c: Contact, r: vec3<f32>, dir: vec3<f32>) -> f32 {
+    if (c.partner == GROUND) {
+        return 0.0;
+    }
+    return effective_inv_mass(props[c.partner], state_in[c.partner].rot, r, dir);
+}
+
+// Restitution and friction of a contact: the larger restitution and the
+// geometric mean of the frictions (Box2D's rule); the ground's material is
+// settings.restitution and settings.friction.
+fn combined_restitution(p: BodyProps, c: Contact) -> f32 {
+    if (c.partner == GROUND) {
+        return max(p.material.x, params.ground_restitution);
+    }
+    return max(p.material.x, props[c.partner].material.x);
+}
+
+fn combined_friction(p: BodyProps, c: Contact) -> f32 {
+    if (c.partner == GROUND) {
+        return sqrt(p.material.y * params.ground_friction);
+    }
+    return sqrt(p.material.y * props[c.partner].material.y);
 }

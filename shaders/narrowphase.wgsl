@@ -5,6 +5,8 @@
 // index first), so both bodies of a pair store the same points, mirrored.
 // Contacts are generated up to a speculative gap (the distance the pair can
 // close in one step), so fast bodies meet walls instead of passing them.
+// Contacts with the ground come first: a box's corners near it, a sphere's
+// lowest point.
 
 // Gap kept as contact whatever the speed (m).
 const CONTACT_MARGIN: f32 = 0.02;
@@ -19,12 +21,56 @@ fn shape_of(i: u32) -> Shape {
     return Shape(s.pos.xyz, s.rot, p.half_extents.xyz, p.kind.x);
 }
 
-// How far body i may move in the coming step (m): its last displacement,
-// rescaled to this dt, plus what gravity adds.
+// How far body i may move in the coming step, all its substeps (m): its last
+// displacement, rescaled to this step, plus what gravity adds.
 fn reach_of(i: u32) -> f32 {
     let s = state_in[i];
-    let ratio = params.dt / params.dt_prev;
-    return length(s.pos.xyz - s.prev_pos.xyz) * ratio + length(params.gravity.xyz) * params.dt * params.dt;
+    let steps = f32(params.substeps);
+    let ratio = params.dt / params.dt_prev * steps;
+    let h = params.dt * steps;
+    return length(s.pos.xyz - s.prev_pos.xyz) * ratio + length(params.gravity.xyz) * h * h;
+}
+
+fn add_contact(c: Contact) {
+    wanted = wanted + 1u;
+    if (self_count < MAX_CONTACTS) {
+        contacts[self_index * MAX_CONTACTS + self_count] = c;
+        self_count = self_count + 1u;
+    }
+}
+
+// A box's corners, or a sphere's lowest point, within the margin of the ground.
+fn ground_contacts(i: u32, margin: f32) {
+    let s = state_in[i];
+    let p = props[i];
+    let ground = params.gravity.w;
+    if (s.pos.y - p.half_extents.w - ground > margin) {
+        return;
+    }
+    var c: Contact;
+    c.partner = GROUND;
+    c.pushed = 0.0;
+    c.normal = vec3<f32>(0.0, 1.0, 0.0);
+    if (p.kind.x == SHAPE_SPHERE) {
+        let lowest = s.pos.xyz - vec3<f32>(0.0, p.half_extents.x, 0.0);
+        c.local_self = quat_rotate(quat_conj(s.rot), lowest - s.pos.xyz);
+        c.local_partner = vec3<f32>(lowest.x, ground, lowest.z);
+        add_contact(c);
+        return;
+    }
+    for (var k = 0u; k < 8u; k = k + 1u) {
+        let corner = vec3<f32>(
+            select(-1.0, 1.0, (k & 1u) != 0u),
+            select(-1.0, 1.0, (k & 2u) != 0u),
+            select(-1.0, 1.0, (k & 4u) != 0u),
+        ) * p.half_extents.xyz;
+        let w = s.pos.xyz + quat_rotate(s.rot, corner);
+        if (w.y - ground <= margin) {
+            c.local_self = corner;
+            c.local_partner = vec3<f32>(w.x, ground, w.z);
+            add_contact(c);
+        }
+    }
 }
 
 fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
@@ -52,12 +98,9 @@ fn consider(j: u32) {
     }
     let m = collide(shape_of(lo), shape_of(hi), margin);
     for (var k = 0u; k < m.count; k = k + 1u) {
-        wanted = wanted + 1u;
-        if (self_count >= MAX_CONTACTS) {
-            continue;
-        }
         var c: Contact;
         c.partner = j;
+        c.pushed = 0.0;
         if (i == lo) {
             c.local_self = world_to_local(i, m.on_a[k]);
             c.local_partner = world_to_local(j, m.on_b[k]);
@@ -67,8 +110,7 @@ fn consider(j: u32) {
             c.local_partner = world_to_local(j, m.on_a[k]);
             c.normal = m.normal;
         }
-        contacts[i * MAX_CONTACTS + self_count] = c;
-        self_count = self_count + 1u;
+        add_contact(c);
     }
 }
 
@@ -101,6 +143,9 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     // fixed bodies keep no contacts: they never move
     if (!is_fixed(p)) {
         let my_reach = reach_of(i);
+        if (params.has_ground != 0u) {
+            ground_contacts(i, CONTACT_MARGIN + my_reach);
+        }
         let centre = state_in[i].pos.xyz;
         var lo = cell_of(centre) - vec3<i32>(1);
         var hi = cell_of(centre) + vec3<i32>(1);

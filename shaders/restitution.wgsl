@@ -1,34 +1,20 @@
-// Pass "restitution", once per step after the solve: collisions change
+// Pass "restitution", once per substep after the solve: collisions change
 // velocity by rewriting the previous pose (the paper, section III). A contact
 // that was approaching faster than a resting contact can (2 |g| dt) leaves
 // with -e times its approach speed along the normal; slower ones stay at
-// rest, so resting bodies do not hop.
+// rest, so resting bodies do not hop. Every contact is measured on the
+// velocities after the solve and the changes summed, so symmetric contacts
+// stay symmetric.
 
-// Velocities a pose implies: (linear, angular) from the pose and its previous one.
+// Velocities a pose implies: (x - x_prev) / dt and the rotation q q_prev^*.
 fn implied_velocity(s: BodyState) -> Velocity {
-    let dt = params.dt;
-    let v = (s.pos.xyz - s.prev_pos.xyz) / dt;
-    let w = quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))) / dt;
+    let v = (s.pos.xyz - s.prev_pos.xyz) / params.dt;
+    let w = quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))) / params.dt;
     return Velocity(vec4<f32>(v, 0.0), vec4<f32>(w, 0.0));
 }
 
-// Bounce of one touching contact: if the points were approaching faster than
-// the threshold, make them part at e times that speed (this body's share).
-fn bounce(v: ptr<function, vec3<f32>>, w: ptr<function, vec3<f32>>, s: BodyState, p: BodyProps,
-          r: vec3<f32>, n: vec3<f32>, approach_before: f32, partner_now: vec3<f32>, w_partner: f32, e: f32) -> bool {
-    let threshold = 2.0 * length(params.gravity.xyz) * params.dt;
-    if (approach_before > -threshold) {
-        return false;
-    }
-    let vn = dot(*v + cross(*w, r) - partner_now, n);
-    let target_vn = -e * approach_before;
-    if (vn >= target_vn) {
-        return false;
-    }
-    let lambda = (target_vn - vn) / (effective_inv_mass(p, s.rot, r, n) + w_partner);
-    *v = *v + n * (p.inv_inertia.w * lambda);
-    *w = *w + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * lambda;
-    return true;
+fn point_velocity(v: Velocity, r: vec3<f32>) -> vec3<f32> {
+    return v.linear.xyz + cross(v.angular.xyz, r);
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -39,47 +25,49 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var s = state_in[i];
     let p = props[i];
-    if (is_fixed(p)) {
+    let count = contact_count[i];
+    if (is_fixed(p) || count == 0u) {
         state_out[i] = s;
         return;
     }
     let before = vel0[i];
     let now = implied_velocity(s);
-    var v = now.linear.xyz;
-    var w = now.angular.xyz;
-    var changed = false;
-    if (params.has_ground != 0u) {
-        let n = vec3<f32>(0.0, 1.0, 0.0);
-        let e = max(p.material.x, params.ground_restitution);
-        let count = ground_point_count(p);
-        for (var k = 0u; k < count; k = k + 1u) {
-            let r = ground_point_offset(p, s.rot, k);
-            if ((s.pos.y + r.y) - params.gravity.w > CONTACT_SLOP) {
-                continue;
-            }
-            let approach = dot(before.linear.xyz + cross(before.angular.xyz, r), n);
-            changed = bounce(&v, &w, s, p, r, n, approach, vec3<f32>(0.0), 0.0, e) || changed;
-        }
-    }
-    let contacts_here = contact_count[i];
-    for (var k = 0u; k < contacts_here; k = k + 1u) {
-        let c = contacts[i * MAX_CONTACTS + k];
-        let o = state_in[c.partner];
-        let q = props[c.partner];
-        let r = quat_rotate(s.rot, c.local_self);
-        let r_o = quat_rotate(o.rot, c.local_partner);
+    let threshold = 2.0 * length(params.gravity.xyz) * params.dt;
+    var dv = vec3<f32>(0.0);
+    var dw = vec3<f32>(0.0);
+    let first = i * MAX_CONTACTS;
+    for (var k = first; k < first + count; k = k + 1u) {
+        let c = contacts[k];
+        let o = partner_point(c);
         let n = c.normal;
-        if (dot((s.pos.xyz + r) - (o.pos.xyz + r_o), n) > CONTACT_SLOP) {
+        let r = quat_rotate(s.rot, c.local_self);
+        // touching?
+        if (dot((s.pos.xyz + r) - o.point, n) > CONTACT_SLOP) {
             continue;
         }
-        let b = vel0[c.partner];
-        let approach = dot(before.linear.xyz + cross(before.angular.xyz, r) - (b.linear.xyz + cross(b.angular.xyz, r_o)), n);
-        let o_now = implied_velocity(o);
-        let partner_point = o_now.linear.xyz + cross(o_now.angular.xyz, r_o);
-        let e = max(p.material.x, q.material.x);
-        changed = bounce(&v, &w, s, p, r, n, approach, partner_point, effective_inv_mass(q, o.rot, r_o, n), e) || changed;
+        // approach speed of the two points before the solve, and now
+        var partner_before = vec3<f32>(0.0);
+        var partner_now = vec3<f32>(0.0);
+        if (c.partner != GROUND) {
+            partner_before = point_velocity(vel0[c.partner], o.r);
+            partner_now = point_velocity(implied_velocity(state_in[c.partner]), o.r);
+        }
+        let approach = dot(point_velocity(before, r) - partner_before, n);
+        if (approach > -threshold) {
+            continue;
+        }
+        let vn = dot(point_velocity(now, r) - partner_now, n);
+        let target_vn = -combined_restitution(p, c) * approach;
+        if (vn >= target_vn) {
+            continue;
+        }
+        let lambda = (target_vn - vn) / (effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n));
+        dv = dv + n * (p.inv_inertia.w * lambda);
+        dw = dw + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * lambda;
     }
-    if (changed) {
+    if (any(dv != vec3<f32>(0.0)) || any(dw != vec3<f32>(0.0))) {
+        let v = now.linear.xyz + dv;
+        let w = now.angular.xyz + dw;
         s.prev_pos = vec4<f32>(s.pos.xyz - v * params.dt, 0.0);
         s.prev_rot = normalize(quat_mul(quat_from_rotvec(-w * params.dt), s.rot));
     }

@@ -63,6 +63,10 @@ struct RunArgs {
     /// K for --trace and --frames.
     #[arg(long, default_value_t = 1)]
     every: u64,
+    /// Time every stage of every step (GPU timestamps where the adapter has
+    /// them) and print the cost per stage; steps are then submitted one by one.
+    #[arg(long)]
+    profile: bool,
     /// Write PNG frames into this directory.
     #[arg(long)]
     frames: Option<PathBuf>,
@@ -150,6 +154,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let setup = started.elapsed();
     let started = Instant::now();
     let chunk = if trace.is_some() { args.every } else { args.steps.max(1) };
+    let profile = args.profile;
+    let mut stage_ms: Vec<(verlet::step::Stage, f64)> = Vec::new();
+    let mut timed_by_gpu = false;
     let mut record = |world: &World| -> Result<(), Error> {
         if let Some((path, w)) = trace.as_mut() {
             let bodies = world.read_state()?;
@@ -160,7 +167,18 @@ fn run(args: RunArgs) -> Result<(), Error> {
     record(&world)?;
     while world.step_count() < args.steps {
         let n = chunk.min(args.steps - world.step_count());
-        world.step(n)?;
+        if profile {
+            let t = world.profile(n)?;
+            timed_by_gpu = t.gpu_timestamps;
+            for (k, (stage, ms)) in t.ms_per_step.into_iter().enumerate() {
+                match stage_ms.get_mut(k) {
+                    Some(entry) => entry.1 += ms * n as f64,
+                    None => stage_ms.push((stage, ms * n as f64)),
+                }
+            }
+        } else {
+            world.step(n)?;
+        }
         record(&world)?;
     }
     drop(record);
@@ -182,6 +200,20 @@ fn run(args: RunArgs) -> Result<(), Error> {
         gpu.describe()
     );
     println!("set-up {:.2} s, stepping {:.2} s ({ms:.3} ms/step, wall clock)", setup.as_secs_f64(), wall.as_secs_f64());
+    if profile {
+        let source = if timed_by_gpu { "GPU timestamps" } else { "wall clock per pass" };
+        println!("per stage, ms/step ({source}):");
+        for (stage, total) in &stage_ms {
+            println!("  {:<18} {:>9.3}", stage.name(), total / args.steps.max(1) as f64);
+        }
+    }
+    let report = world.contact_report()?;
+    if report.overflowed() {
+        eprintln!(
+            "warning: contact lists overflowed: a body wanted {} contact points, {} fit; the farthest were dropped",
+            report.run_max, report.capacity
+        );
+    }
     if let Some((lowest, b)) = bodies.iter().enumerate().min_by(|a, b| a.1.position[1].total_cmp(&b.1.position[1])) {
         let fastest = bodies.iter().map(|b| glam::Vec3::from(b.linear_velocity).length()).fold(0.0, f32::max);
         println!(

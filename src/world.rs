@@ -30,6 +30,8 @@ struct WorldData {
     states: [wgpu::Buffer; 2],
     params: wgpu::Buffer,
     status: wgpu::Buffer,
+    contacts: wgpu::Buffer,
+    contact_count: wgpu::Buffer,
     /// `bind_groups[k]` reads `states[k]` and writes `states[1 - k]`.
     bind_groups: [wgpu::BindGroup; 2],
     /// Every other buffer, kept alive for the bind groups.
@@ -72,6 +74,14 @@ pub fn plan_grid(radii: &[f32]) -> (Vec<u32>, GridLayout) {
     let speculative = 0.5 * r;
     let hash_size = (2 * radii.len()).max(1024).next_power_of_two() as u32;
     (large, GridLayout { cell_size: 2.0 * r + speculative, hash_size, speculative })
+}
+
+/// Time per step spent in each stage (ms), from `World::profile`.
+#[derive(Clone, Debug)]
+pub struct StageTimes {
+    pub ms_per_step: Vec<(Stage, f64)>,
+    /// True: GPU timestamp queries; false: wall clock around each pass.
+    pub gpu_timestamps: bool,
 }
 
 /// What the GPU reports about the contact lists.
@@ -212,8 +222,8 @@ impl World {
             })
         };
         let bind_groups = [bind_group(0), bind_group(1)];
-        let others = vec![props_buf, vel0, cell_count, cell_start, block_sums, sorted, large_buf, contacts, contact_count];
-        let data = WorldData { states: state_bufs, params, status, bind_groups, _others: others };
+        let others = vec![props_buf, vel0, cell_count, cell_start, block_sums, sorted, large_buf];
+        let data = WorldData { states: state_bufs, params, status, contacts, contact_count, bind_groups, _others: others };
         let substep_dt = settings.dt / settings.substeps as f32;
         Ok(World {
             gpu,
@@ -287,7 +297,8 @@ impl World {
         Ok(())
     }
 
-    fn encode_and_submit(&mut self, dts: &[f32], substeps: usize) {
+    /// Writes one Params slot per substep of `dts`.
+    fn write_params(&mut self, dts: &[f32], substeps: usize) -> usize {
         let s = &self.settings;
         // one Params slot per substep of the batch
         let mut slots = vec![0u8; PARAMS_STRIDE as usize * dts.len() * substeps];
@@ -311,6 +322,7 @@ impl World {
                     hash_size: self.grid.hash_size,
                     large_count: self.large_count,
                     speculative: self.grid.speculative,
+                    substeps: substeps as u32,
                     ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;
@@ -320,34 +332,143 @@ impl World {
             }
         }
         self.gpu.queue.write_buffer(&self.data.params, 0, &slots);
+        slot
+    }
+
+    fn finish_steps(&mut self, dts: &[f32], substeps: usize) {
+        self.dt_prev = dts.last().map_or(self.dt_prev, |&dt| dt / substeps as f32);
+        self.step += dts.len() as u64;
+        self.time += dts.iter().map(|&d| d as f64).sum::<f64>();
+    }
+
+    fn encode_and_submit(&mut self, dts: &[f32], substeps: usize) {
+        let slot = self.write_params(dts, substeps);
 
         let mut encoder = self
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("step") });
-        for slot in 0..slot {
-            let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
-            for stage in Stage::ALL {
-                let repeats = if stage == Stage::Solve { self.settings.iterations } else { 1 };
-                for _ in 0..repeats {
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some(stage.name()),
-                        timestamp_writes: None,
-                    });
-                    pass.set_pipeline(self.pipelines.pipeline(stage));
-                    pass.set_bind_group(0, &self.data.bind_groups[self.current], &offset);
-                    pass.dispatch_workgroups(self.workgroups(stage.over()), 1, 1);
-                    drop(pass);
-                    if stage.flips_state() {
-                        self.current = 1 - self.current;
-                    }
-                }
+        let plan = self.step_plan();
+        for first in (0..slot).step_by(substeps) {
+            for &(stage, sub) in &plan {
+                self.encode_pass(&mut encoder, stage, first + sub, None);
             }
         }
         self.gpu.queue.submit([encoder.finish()]);
-        self.dt_prev = dt_prev;
-        self.step += dts.len() as u64;
-        self.time += dts.iter().map(|&d| d as f64).sum::<f64>();
+        self.finish_steps(dts, substeps);
+    }
+
+    /// The passes of one step, each with the substep whose Params it uses:
+    /// the broadphase and narrowphase once, then for every substep the
+    /// integration, `iterations` solves and restitution (the contacts, kept
+    /// in the bodies' own frames, serve all substeps).
+    pub fn step_plan(&self) -> Vec<(Stage, usize)> {
+        let mut plan: Vec<(Stage, usize)> = Stage::ALL.iter().take_while(|s| **s != Stage::Integrate).map(|&s| (s, 0)).collect();
+        for sub in 0..self.settings.substeps as usize {
+            plan.push((Stage::Integrate, sub));
+            plan.extend(std::iter::repeat_n((Stage::Solve, sub), self.settings.iterations as usize));
+            plan.push((Stage::Restitution, sub));
+        }
+        plan
+    }
+
+    /// Records one dispatch of `stage` with the Params of batch slot `slot`,
+    /// optionally with timestamps, and flips the current state if it writes.
+    fn encode_pass(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        stage: Stage,
+        slot: usize,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(stage.name()),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(self.pipelines.pipeline(stage));
+        pass.set_bind_group(0, &self.data.bind_groups[self.current], &offset);
+        pass.dispatch_workgroups(self.workgroups(stage.over()), 1, 1);
+        drop(pass);
+        if stage.flips_state() {
+            self.current = 1 - self.current;
+        }
+    }
+
+    /// Takes `steps` steps of `settings.dt` one at a time, timing every pass:
+    /// with GPU timestamp queries where the adapter has them, else by the
+    /// wall clock around each pass submitted and waited for alone (which
+    /// adds the submission's overhead to every pass).
+    pub fn profile(&mut self, steps: u64) -> Result<StageTimes, Error> {
+        let plan = self.step_plan();
+        let substeps = self.settings.substeps as usize;
+        let passes = plan.len();
+        let mut totals = vec![0.0f64; Stage::ALL.len()];
+        let gpu = self.gpu.clone();
+        let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let queries = timestamps.then(|| {
+            let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("profile"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * passes as u32,
+            });
+            let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("profile/resolve"),
+                size: 16 * passes as u64,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolve)
+        });
+        for _ in 0..steps {
+            let dt = [self.settings.dt];
+            self.write_params(&dt, substeps);
+            let mut k = 0;
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            {
+                for &(stage, slot) in &plan {
+                    match &queries {
+                        Some((set, _)) => {
+                            let writes = wgpu::ComputePassTimestampWrites {
+                                query_set: set,
+                                beginning_of_pass_write_index: Some(2 * k as u32),
+                                end_of_pass_write_index: Some(2 * k as u32 + 1),
+                            };
+                            self.encode_pass(&mut encoder, stage, slot, Some(writes));
+                        }
+                        None => {
+                            gpu.queue.submit([encoder.finish()]);
+                            gpu.wait()?;
+                            let started = std::time::Instant::now();
+                            encoder = gpu.device.create_command_encoder(&Default::default());
+                            self.encode_pass(&mut encoder, stage, slot, None);
+                            gpu.queue.submit([encoder.finish()]);
+                            gpu.wait()?;
+                            totals[stage as usize] += started.elapsed().as_secs_f64() * 1e3;
+                            encoder = gpu.device.create_command_encoder(&Default::default());
+                        }
+                    }
+                    k += 1;
+                }
+            }
+            if let Some((set, resolve)) = &queries {
+                encoder.resolve_query_set(set, 0..2 * passes as u32, resolve, 0);
+            }
+            gpu.queue.submit([encoder.finish()]);
+            if let Some((_, resolve)) = &queries {
+                let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&gpu.read_buffer(resolve, 16 * passes as u64)?);
+                let period_ms = gpu.queue.get_timestamp_period() as f64 * 1e-6;
+                for (k, (stage, _)) in plan.iter().enumerate() {
+                    totals[*stage as usize] += ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period_ms;
+                }
+            }
+            self.finish_steps(&dt, substeps);
+        }
+        let n = steps.max(1) as f64;
+        Ok(StageTimes {
+            ms_per_step: Stage::ALL.iter().map(|&s| (s, totals[s as usize] / n)).collect(),
+            gpu_timestamps: timestamps,
+        })
     }
 
     fn workgroups(&self, over: Over) -> u32 {
@@ -370,6 +491,21 @@ impl World {
         let bytes = self.gpu.read_buffer(&self.data.status, 16)?;
         let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         Ok(ContactReport { last_step_max: v[0], run_max: v[1], capacity: MAX_CONTACTS })
+    }
+
+    /// The contact points each body gathered in the last step's narrowphase
+    /// (a blocking readback, for tests and debugging).
+    pub fn read_contacts(&self) -> Result<Vec<Vec<Contact>>, Error> {
+        let n = self.body_count as usize;
+        let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.contact_count, 4 * n.max(1) as u64)?);
+        let size = (n.max(1) * MAX_CONTACTS as usize * std::mem::size_of::<Contact>()) as u64;
+        let all: Vec<Contact> = bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.contacts, size)?);
+        Ok((0..n)
+            .map(|i| {
+                let start = i * MAX_CONTACTS as usize;
+                all[start..start + counts[i].min(MAX_CONTACTS) as usize].to_vec()
+            })
+            .collect())
     }
 
     /// Reads every body's pose back and derives its velocities.

@@ -31,7 +31,7 @@ macro_rules! check_layout {
 
 #[test]
 fn shared_structs_match_member_by_member() {
-    let common = shaders::COMMON;
+    let common = &format!("{}{}", shaders::COMMON, shaders::BINDINGS);
     check_layout!(common, BodyState { pos, prev_pos, rot, prev_rot });
     check_layout!(common, BodyProps { half_extents, inv_inertia, material, kind });
     check_layout!(common, Velocity { linear, angular });
@@ -40,15 +40,15 @@ fn shared_structs_match_member_by_member() {
         Params {
             gravity, dt, dt_prev, relaxation, linear_damping, angular_damping, body_count, has_ground,
             ground_restitution, ground_friction, cell_size, hash_size, large_count, speculative,
-            _pad0, _pad1, _pad2
+            substeps, _pad1, _pad2
         }
     );
-    check_layout!(common, Contact { local_self, partner, local_partner, _pad0, normal, _pad1 });
+    check_layout!(common, Contact { local_self, partner, local_partner, pushed, normal, _pad1 });
 }
 
 #[test]
 fn constants_match() {
-    let module = shaders::validate(shaders::COMMON).unwrap();
+    let module = shaders::validate(&format!("{}{}", shaders::COMMON, shaders::BINDINGS)).unwrap();
     let find = |name: &str| {
         let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
         match module.global_expressions[c.init] {
@@ -61,6 +61,7 @@ fn constants_match() {
     assert_eq!(find("FLAG_FIXED"), FLAG_FIXED);
     assert_eq!(find("WORKGROUP"), WORKGROUP);
     assert_eq!(find("MAX_CONTACTS"), MAX_CONTACTS);
+    assert_eq!(find("GROUND"), GROUND);
     let grid = format!("{}{}{}", shaders::COMMON, shaders::BINDINGS, shaders::GRID);
     let module = shaders::validate(&grid).unwrap();
     let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some("SCAN_BLOCK")).unwrap();

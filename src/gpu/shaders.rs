@@ -3,7 +3,6 @@
 
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
 pub const BINDINGS: &str = include_str!("../../shaders/bindings.wgsl");
-pub const GROUND: &str = include_str!("../../shaders/ground.wgsl");
 pub const GRID: &str = include_str!("../../shaders/grid.wgsl");
 pub const COLLIDE: &str = include_str!("../../shaders/collide.wgsl");
 pub const NARROWPHASE: &str = include_str!("../../shaders/narrowphase.wgsl");
@@ -25,8 +24,8 @@ pub const PASSES: &[(&str, &[&str])] = &[
     ("grid_sort", GRID_PASS),
     ("narrowphase", &[COMMON, BINDINGS, GRID, COLLIDE, NARROWPHASE]),
     ("integrate", &[COMMON, BINDINGS, INTEGRATE]),
-    ("solve", &[COMMON, BINDINGS, GROUND, SOLVE]),
-    ("restitution", &[COMMON, BINDINGS, GROUND, RESTITUTION]),
+    ("solve", &[COMMON, BINDINGS, SOLVE]),
+    ("restitution", &[COMMON, BINDINGS, RESTITUTION]),
 ];
 
 /// The assembled source of the named pass.

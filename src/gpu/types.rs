@@ -63,7 +63,8 @@ pub struct Params {
     pub large_count: u32,
     /// Farthest gap (m) at which pairs found through the grid get contacts.
     pub speculative: f32,
-    pub _pad0: u32,
+    /// Substeps per step; contacts found once per step serve them all.
+    pub substeps: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }
@@ -73,12 +74,18 @@ pub struct Params {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Contact {
     pub local_self: [f32; 3],
+    /// Body index, or `GROUND`.
     pub partner: u32,
+    /// In the partner's frame; for the ground, in world coordinates.
     pub local_partner: [f32; 3],
-    pub _pad0: u32,
+    /// Normal push summed over the step's iterations (m): the friction budget.
+    pub pushed: f32,
     pub normal: [f32; 3],
     pub _pad1: u32,
 }
+
+/// The partner of a contact with the ground (`GROUND` in WGSL).
+pub const GROUND: u32 = u32::MAX;
 
 /// Contact slots per body (`MAX_CONTACTS` in WGSL).
 pub const MAX_CONTACTS: u32 = 24;

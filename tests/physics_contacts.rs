@@ -1,0 +1,165 @@
+//! Many bodies colliding (issue 3): piles settle, stacks and pyramids stand,
+//! fast bodies meet walls, friction holds on a ramp, runs repeat bit for bit.
+
+mod common;
+
+use common::{quat, v3, world};
+use glam::{Quat, Vec3};
+use verlet::reference::collide::{collide, Placed, ShapeKind};
+use verlet::scenes::{self, box_body};
+use verlet::{BodyOutput, Scene, Shape};
+
+fn placed(scene: &Scene, i: usize, s: &BodyOutput) -> Placed {
+    let shape = match scene.bodies[i].shape {
+        Shape::Box { half_extents } => ShapeKind::Box(Vec3::from(half_extents)),
+        Shape::Sphere { radius } => ShapeKind::Sphere(radius),
+    };
+    Placed { centre: v3(s.position), rot: quat(s.orientation), shape }
+}
+
+/// Deepest overlap between any two bodies (m), by the CPU reference.
+fn worst_overlap(scene: &Scene, state: &[BodyOutput]) -> f32 {
+    let mut worst = 0.0f32;
+    for i in 0..state.len() {
+        for j in i + 1..state.len() {
+            let reach = scene.bodies[i].bounding_radius() + scene.bodies[j].bounding_radius();
+            if v3(state[i].position).distance(v3(state[j].position)) > reach {
+                continue;
+            }
+            if let Some(m) = collide(&placed(scene, i, &state[i]), &placed(scene, j, &state[j]), 0.0) {
+                for p in &m.points {
+                    worst = worst.max(-p.separation(m.normal));
+                }
+            }
+        }
+    }
+    worst
+}
+
+fn lowest_corner(scene: &Scene, i: usize, s: &BodyOutput) -> f32 {
+    match scene.bodies[i].shape {
+        Shape::Box { half_extents: h } => (0..8)
+            .map(|k| {
+                let c = Vec3::new(
+                    if k & 1 == 0 { -h[0] } else { h[0] },
+                    if k & 2 == 0 { -h[1] } else { h[1] },
+                    if k & 4 == 0 { -h[2] } else { h[2] },
+                );
+                (v3(s.position) + quat(s.orientation) * c).y
+            })
+            .fold(f32::MAX, f32::min),
+        Shape::Sphere { radius } => s.position[1] - radius,
+    }
+}
+
+#[test]
+fn a_thousand_cubes_fall_and_settle() {
+    let scene = scenes::cubes(1000, 7);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(900).unwrap(); // 15 s
+    let state = w.read_state().unwrap(); // fails on any non-finite number
+    let below = (0..state.len()).map(|i| lowest_corner(&scene, i, &state[i])).fold(f32::MAX, f32::min);
+    let overlap = worst_overlap(&scene, &state);
+    let fastest = state.iter().map(|b| v3(b.linear_velocity).length()).fold(0.0, f32::max);
+    let report = w.contact_report().unwrap();
+    eprintln!("1000 cubes after 15 s: lowest corner {below} m, worst overlap {overlap} m, fastest {fastest} m/s, {report:?}");
+    assert!(below > -0.01, "a corner is {} m below the ground", -below);
+    assert!(overlap < 0.02, "two cubes overlap by {overlap} m");
+    assert!(fastest < 0.1, "a cube still moves at {fastest} m/s");
+    assert!(!report.overflowed(), "contact lists overflowed: {report:?}");
+}
+
+#[test]
+fn a_column_of_ten_boxes_stands() {
+    let scene = scenes::stack(10);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(600).unwrap();
+    let top = w.read_state().unwrap()[9];
+    let drift = Vec3::new(top.position[0], 0.0, top.position[2]).length();
+    eprintln!("stack of 10 after 10 s: top drifted {drift} m sideways, at height {}", top.position[1]);
+    assert!(drift < 0.02, "top box drifted {drift} m");
+    assert!((top.position[1] - 9.5).abs() < 0.05, "top box at {}", top.position[1]);
+}
+
+#[test]
+fn a_pyramid_of_ten_rows_stands() {
+    let scene = scenes::pyramid(10);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(600).unwrap();
+    let state = w.read_state().unwrap();
+    let moved = scene
+        .bodies
+        .iter()
+        .zip(&state)
+        .map(|(b, s)| (v3(s.position) - Vec3::from(b.position)).length())
+        .fold(0.0, f32::max);
+    eprintln!("pyramid of 10 rows after 10 s: largest move {moved} m");
+    assert!(moved < 0.05, "a box moved {moved} m");
+}
+
+#[test]
+fn a_fast_box_does_not_pass_through_a_wall() {
+    let mut scene = scenes::stack(0);
+    let mut wall = box_body([0.1, 2.0, 2.0], [5.0, 2.0, 0.0]);
+    wall.fixed = true;
+    let mut bullet = box_body([0.25; 3], [0.0, 1.0, 0.0]);
+    bullet.linear_velocity = [20.0, 0.0, 0.0];
+    scene.bodies = vec![wall, bullet];
+    let Some(mut w) = world(&scene) else { return };
+    let mut farthest = f32::MIN;
+    for _ in 0..90 {
+        w.step(1).unwrap();
+        farthest = farthest.max(w.read_state().unwrap()[1].position[0]);
+    }
+    eprintln!("bullet box: farthest x {farthest} (wall face at 4.9)");
+    assert!(farthest < 4.9 - 0.25 + 0.05, "the box reached x = {farthest}: through the wall");
+}
+
+fn ramp_slide(mu: f32) -> f32 {
+    let angle = 20f32.to_radians();
+    let tilt = Quat::from_rotation_z(angle);
+    let mut scene = scenes::stack(0);
+    let mut ramp = box_body([5.0, 0.1, 2.0], [0.0, 3.0, 0.0]);
+    ramp.orientation = tilt.to_array();
+    ramp.fixed = true;
+    ramp.friction = Some(mu);
+    // the block starts near the upper (left) end, resting on the surface
+    let along = tilt * Vec3::X;
+    let normal = tilt * Vec3::Y;
+    let start = Vec3::new(0.0, 3.0, 0.0) - along * 3.5 + normal * (0.1 + 0.25);
+    let mut block = box_body([0.25; 3], start.to_array());
+    block.orientation = tilt.to_array();
+    block.friction = Some(mu);
+    scene.bodies = vec![ramp, block];
+    let Some(mut w) = world(&scene) else { return f32::NAN };
+    w.step(120).unwrap();
+    (v3(w.read_state().unwrap()[1].position) - start).length()
+}
+
+#[test]
+fn a_block_holds_on_a_ramp_with_friction_and_slides_without() {
+    let held = ramp_slide(0.6);
+    let slid = ramp_slide(0.1);
+    if held.is_nan() {
+        return;
+    }
+    // sliding down 20 degrees with mu = 0.1: a = g (sin - mu cos), d = a t^2 / 2
+    let a = 9.81 * (20f32.to_radians().sin() - 0.1 * 20f32.to_radians().cos());
+    let expected = 0.5 * a * 2.0 * 2.0;
+    eprintln!("ramp: moved {held} m with mu 0.6, {slid} m with mu 0.1 (frictionless-slide theory {expected} m)");
+    assert!(held < 0.05, "held block moved {held} m");
+    assert!((slid - expected).abs() < 0.2 * expected, "slid {slid} m, Coulomb friction says {expected} m");
+}
+
+#[test]
+fn same_scene_same_bits() {
+    let scene = scenes::cubes(1000, 3);
+    let run = || {
+        let mut w = world(&scene)?;
+        w.step(300).unwrap();
+        Some(w.read_raw().unwrap())
+    };
+    let Some(first) = run() else { return };
+    let second = run().unwrap();
+    assert!(bytemuck::cast_slice::<_, u8>(&first) == bytemuck::cast_slice::<_, u8>(&second), "two runs differ");
+}
