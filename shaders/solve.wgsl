@@ -30,15 +30,20 @@ fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact)
     let n = c.normal;
     let r = quat_rotate(s.rot, c.local_self);
     let depth = dot(o.point - (s.pos.xyz + r), n);
-    if (depth <= 0.0) {
+    // a contact that pushed earlier in this step keeps its friction while it
+    // still touches, even once its depth is resolved, so sideways pushes from other contacts in
+    // later iterations are resisted too
+    var push = 0.0;
+    if (depth > 0.0) {
+        add_push(acc, p, s.rot, r, n, depth / (effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n)));
+        push = depth * params.relaxation;
+    } else if (c.pushed <= 0.0 || depth < -CONTACT_SLOP) {
         return 0.0;
     }
-    add_push(acc, p, s.rot, r, n, depth / (effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n)));
 
     let slip = (s.pos.xyz + r) - (s.prev_pos.xyz + quat_rotate(s.prev_rot, c.local_self)) - (o.point - o.before);
     let slip_t = slip - n * dot(slip, n);
     let slide = length(slip_t);
-    let push = depth * params.relaxation;
     if (slide > 1e-9) {
         let t = slip_t / slide;
         let undo = min(slide, combined_friction(p, c) * (c.pushed + push));
@@ -62,11 +67,22 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     var acc = Snap(vec3<f32>(0.0), vec3<f32>(0.0));
     let first = i * MAX_CONTACTS;
     let count = contact_count[i];
+    var touching = 0u;
     for (var k = first; k < first + count; k = k + 1u) {
+        let before = acc;
         let push = add_contact(&acc, s, p, contacts[k]);
         contacts[k].pushed = contacts[k].pushed + push;
+        if (any(acc.dx != before.dx) || any(acc.dtheta != before.dtheta)) {
+            touching = touching + 1u;
+        }
     }
+    // Each contact's snap turns the body as if it were the only one; summed
+    // over several contacts the turns overshoot (four corners correcting a
+    // twist turn it back about twice too far), so the rotation is split
+    // among the active contacts (mass splitting, for the inertia only: the
+    // translations of a face's points already add up to the face's push).
+    let split = 1.0 / f32(max(touching, 1u));
     s.pos = vec4<f32>(s.pos.xyz + acc.dx * params.relaxation, 0.0);
-    s.rot = quat_add_rotation(s.rot, acc.dtheta * params.relaxation);
+    s.rot = quat_add_rotation(s.rot, acc.dtheta * (params.relaxation * split));
     state_out[i] = s;
 }
