@@ -12,6 +12,11 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let s = state_in[i];
     let p = props[i];
     let dt = params.dt;
+    // a new substep: its contacts' friction budgets start empty
+    let first = i * MAX_CONTACTS;
+    for (var k = first; k < first + contact_count[i]; k = k + 1u) {
+        contacts[k].pushed = 0.0;
+    }
     if (is_fixed(p)) {
         state_out[i] = BodyState(s.pos, s.pos, s.rot, s.rot);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));

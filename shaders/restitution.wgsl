@@ -2,9 +2,11 @@
 // velocity by rewriting the previous pose (the paper, section III). A contact
 // that was approaching faster than a resting contact can (2 |g| dt) leaves
 // with -e times its approach speed along the normal; slower ones stay at
-// rest, so resting bodies do not hop. Every contact is measured on the
-// velocities after the solve and the changes summed, so symmetric contacts
-// stay symmetric.
+// rest, so resting bodies do not hop. Dynamic friction acts here too: a
+// contact still sliding after the solve loses up to mu times the normal
+// velocity change its push made (mu |dv_n|, Coulomb's law per substep).
+// Every contact is measured on the velocities after the solve and the
+// changes summed, the turns split among the contacts as in the solve.
 
 // Velocities a pose implies: (x - x_prev) / dt and the rotation q q_prev^*.
 fn implied_velocity(s: BodyState) -> Velocity {
@@ -35,6 +37,7 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     let threshold = 2.0 * length(params.gravity.xyz) * params.dt;
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
+    var acting = 0u;
     let first = i * MAX_CONTACTS;
     for (var k = first; k < first + count; k = k + 1u) {
         let c = contacts[k];
@@ -52,19 +55,35 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
             partner_before = point_velocity(vel0[c.partner], o.r);
             partner_now = point_velocity(implied_velocity(state_in[c.partner]), o.r);
         }
+        let relative_now = point_velocity(now, r) - partner_now;
+        let w_self_n = effective_inv_mass(p, s.rot, r, n);
+        var acted = false;
+        // dynamic friction against the sliding left after the solve
+        let v_t = relative_now - n * dot(relative_now, n);
+        let sliding = length(v_t);
+        if (c.pushed > 0.0 && sliding > 1e-6) {
+            let t = v_t / sliding;
+            let cut = min(combined_friction(p, c) * c.pushed / params.dt, sliding);
+            let lambda_t = cut / (effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t));
+            dv = dv - t * (p.inv_inertia.w * lambda_t);
+            dw = dw - inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, t)) * lambda_t;
+            acted = true;
+        }
+        // restitution of a fast approach
         let approach = dot(point_velocity(before, r) - partner_before, n);
-        if (approach > -threshold) {
-            continue;
-        }
-        let vn = dot(point_velocity(now, r) - partner_now, n);
+        let vn = dot(relative_now, n);
         let target_vn = -combined_restitution(p, c) * approach;
-        if (vn >= target_vn) {
-            continue;
+        if (approach < -threshold && vn < target_vn) {
+            let lambda = (target_vn - vn) / (w_self_n + partner_inv_mass(c, o.r, n));
+            dv = dv + n * (p.inv_inertia.w * lambda);
+            dw = dw + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * lambda;
+            acted = true;
         }
-        let lambda = (target_vn - vn) / (effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n));
-        dv = dv + n * (p.inv_inertia.w * lambda);
-        dw = dw + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * lambda;
+        if (acted) {
+            acting = acting + 1u;
+        }
     }
+    dw = dw / f32(max(acting, 1u));
     if (any(dv != vec3<f32>(0.0)) || any(dw != vec3<f32>(0.0))) {
         let v = now.linear.xyz + dv;
         let w = now.angular.xyz + dw;

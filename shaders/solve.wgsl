@@ -21,18 +21,18 @@ fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>
 
 // One contact: the normal snap takes this body's share of the depth,
 // w_self / (w_self + w_partner), the partner the rest in its own thread.
-// Friction undoes the relative sliding of the two material points since
-// their previous poses, up to mu times the normal push summed over the
-// step's iterations so far (static friction in positions, as XPBD does).
-// Returns the contact's push this iteration (m).
+// Static friction (as XPBD has it): if the two material points have slid
+// apart since their previous poses by less than mu times the normal push
+// summed over this substep, the slide is undone; a larger slide is left to
+// dynamic friction in the restitution pass. Returns the push (m).
 fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
     let o = partner_point(c);
     let n = c.normal;
     let r = quat_rotate(s.rot, c.local_self);
     let depth = dot(o.point - (s.pos.xyz + r), n);
-    // a contact that pushed earlier in this step keeps its friction while it
-    // still touches, even once its depth is resolved, so sideways pushes from other contacts in
-    // later iterations are resisted too
+    // a contact that pushed earlier in this substep keeps its friction while
+    // it still touches, even once its depth is resolved, so sideways pushes
+    // from other contacts in later iterations are resisted too
     var push = 0.0;
     if (depth > 0.0) {
         add_push(acc, p, s.rot, r, n, depth / (effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n)));
@@ -40,14 +40,12 @@ fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact)
     } else if (c.pushed <= 0.0 || depth < -CONTACT_SLOP) {
         return 0.0;
     }
-
     let slip = (s.pos.xyz + r) - (s.prev_pos.xyz + quat_rotate(s.prev_rot, c.local_self)) - (o.point - o.before);
     let slip_t = slip - n * dot(slip, n);
     let slide = length(slip_t);
-    if (slide > 1e-9) {
+    if (slide > 1e-9 && slide <= combined_friction(p, c) * (c.pushed + push)) {
         let t = slip_t / slide;
-        let undo = min(slide, combined_friction(p, c) * (c.pushed + push));
-        add_push(acc, p, s.rot, r, -t, undo / (effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t)));
+        add_push(acc, p, s.rot, r, -t, slide / (effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t)));
     }
     return push;
 }

@@ -222,6 +222,7 @@ impl World {
             })
         };
         let bind_groups = [bind_group(0), bind_group(1)];
+        gpu.check()?;
         let others = vec![props_buf, vel0, cell_count, cell_start, block_sums, sorted, large_buf];
         let data = WorldData { states: state_bufs, params, status, contacts, contact_count, bind_groups, _others: others };
         let substep_dt = settings.dt / settings.substeps as f32;
@@ -312,8 +313,9 @@ impl World {
                     dt: h,
                     dt_prev,
                     relaxation: s.relaxation,
-                    linear_damping: s.linear_damping,
-                    angular_damping: s.angular_damping,
+                    // the paper's beta is per step: spread it over the substeps
+                    linear_damping: per_substep(s.linear_damping, substeps),
+                    angular_damping: per_substep(s.angular_damping, substeps),
                     body_count: self.body_count,
                     has_ground: self.ground.is_some() as u32,
                     ground_restitution: s.restitution,
@@ -530,6 +532,11 @@ impl World {
         }
         Ok(out)
     }
+}
+
+/// The damping per substep that removes `beta` per step: 1 - (1 - beta)^(1/n).
+fn per_substep(beta: f32, substeps: usize) -> f32 {
+    1.0 - (1.0 - beta as f64).powf(1.0 / substeps as f64) as f32
 }
 
 fn finite_output(b: &BodyOutput) -> bool {

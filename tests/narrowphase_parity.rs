@@ -54,7 +54,8 @@ fn gpu_manifolds_match_the_cpu_reference() {
         let a = random_body(&mut rng, k, origin);
         let reach = a.bounding_radius() + 0.8;
         let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y);
-        let b = random_body(&mut rng, k / 5 + k, origin + dir * reach * rng.f());
+        let at = origin + dir * reach * rng.f();
+        let b = random_body(&mut rng, k / 5 + k, at);
         bodies.push(a);
         bodies.push(b);
     }

@@ -28,6 +28,9 @@ pub struct Gpu {
     /// The limits the device was opened with (the adapter's own, raised from
     /// wgpu's defaults so large scenes fit).
     pub limits: wgpu::Limits,
+    /// The first error the device reported outside an error scope; wgpu's
+    /// default would panic, this turns it into an `Err` at the next wait.
+    errors: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl fmt::Debug for Gpu {
@@ -86,7 +89,14 @@ impl Gpu {
             })
             .await
             .map_err(|e| GpuError::Device(e.to_string()))?;
-        Ok(Gpu { adapter, device, queue, info, limits })
+        let errors = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let sink = errors.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut first) = sink.lock() {
+                first.get_or_insert_with(|| e.to_string().replace('\n', " "));
+            }
+        }));
+        Ok(Gpu { adapter, device, queue, info, limits, errors })
     }
 
     /// One line naming the adapter, its backend and driver.
@@ -95,12 +105,20 @@ impl Gpu {
         format!("{} ({:?}, {:?}, driver {} {})", i.name, i.backend, i.device_type, i.driver, i.driver_info)
     }
 
-    /// Waits for all submitted work.
+    /// Waits for all submitted work; reports any error the device raised.
     pub fn wait(&self) -> Result<(), GpuError> {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Runtime(e.to_string()))
+            .map_err(|e| GpuError::Runtime(e.to_string()))?;
+        self.check()
+    }
+
+    /// The first error the device reported, if any.
+    pub fn check(&self) -> Result<(), GpuError> {
+        match self.errors.lock().ok().and_then(|e| e.clone()) {
+            Some(e) => Err(GpuError::Runtime(e)),
+            None => Ok(()),
+        }
     }
 
     /// Copies `size` bytes of `src` to the host (a blocking readback).
