@@ -18,6 +18,7 @@
 pub mod gpu;
 pub mod output;
 pub mod reference;
+pub mod render;
 pub mod scene;
 pub mod scenes;
 pub mod step;
