@@ -18,3 +18,6 @@
 // status[0]: most contact points any body wanted this step, status[1]: in any
 // step so far (a full contact list when either exceeds MAX_CONTACTS)
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
+// ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
+@group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1
+@group(0) @binding(14) var<storage, read> joint_refs: array<JointRef>;          // 2 per joint

@@ -68,6 +68,18 @@ const MAX_CONTACTS: u32 = 24u;
 // Points closer than this (m) still count as touching when restitution is
 // decided after the solve.
 const CONTACT_SLOP: f32 = 0.002;
+// One end of a ball joint as the body at that end sees it: its anchor in its
+// own frame, the partner's anchor in the partner's frame (world coordinates
+// when the partner is WORLD). 32 bytes.
+struct JointRef {
+    local_self: vec3<f32>,
+    partner: u32,
+    local_partner: vec3<f32>,
+    _pad0: u32,
+}
+
+const WORLD: u32 = 0xffffffffu;
+
 // The partner of a contact with the ground plane.
 const GROUND: u32 = 0xffffffffu;
 

@@ -78,9 +78,20 @@ fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
     return quat_rotate(quat_conj(s.rot), p - s.pos.xyz);
 }
 
+// Bodies joined by a joint do not collide: the joint holds them together
+// where their shapes meet.
+fn joined(i: u32, j: u32) -> bool {
+    for (var k = joint_start[i]; k < joint_start[i + 1u]; k = k + 1u) {
+        if (joint_refs[k].partner == j) {
+            return true;
+        }
+    }
+    return false;
+}
+
 fn consider(j: u32) {
     let i = self_index;
-    if (j == i) {
+    if (j == i || joined(i, j)) {
         return;
     }
     let pi = props[i];

@@ -50,6 +50,31 @@ fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact)
     return push;
 }
 
+// One end of a ball joint: snap this body's share of the gap between the two
+// anchors, along the gap.
+fn add_joint(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, j: JointRef) -> bool {
+    let r = quat_rotate(s.rot, j.local_self);
+    var target_point = j.local_partner;
+    var r_o = vec3<f32>(0.0);
+    var w_o = 0.0;
+    if (j.partner != WORLD) {
+        let o = state_in[j.partner];
+        r_o = quat_rotate(o.rot, j.local_partner);
+        target_point = o.pos.xyz + r_o;
+    }
+    let gap = target_point - (s.pos.xyz + r);
+    let dist = length(gap);
+    if (dist < 1e-7) {
+        return false;
+    }
+    let n = gap / dist;
+    if (j.partner != WORLD) {
+        w_o = effective_inv_mass(props[j.partner], state_in[j.partner].rot, r_o, n);
+    }
+    add_push(acc, p, s.rot, r, n, dist / (effective_inv_mass(p, s.rot, r, n) + w_o));
+    return true;
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -71,6 +96,11 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         let push = add_contact(&acc, s, p, contacts[k]);
         contacts[k].pushed = contacts[k].pushed + push;
         if (any(acc.dx != before.dx) || any(acc.dtheta != before.dtheta)) {
+            touching = touching + 1u;
+        }
+    }
+    for (var k = joint_start[i]; k < joint_start[i + 1u]; k = k + 1u) {
+        if (add_joint(&acc, s, p, joint_refs[k])) {
             touching = touching + 1u;
         }
     }

@@ -157,7 +157,9 @@ impl World {
         let storage = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: size.max(16),
+                // at least one element of the largest struct a binding holds (an empty
+                // list still binds a buffer as large as the shader's element)
+                size: size.max(64),
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             })
@@ -181,6 +183,9 @@ impl World {
         let contacts = storage("contacts", count as u64 * MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64);
         let contact_count = storage("contact_count", 4 * count as u64);
         let status = storage("status", 16);
+        let (starts, refs) = joint_lists(scene);
+        let joint_start = with_data("joints/start", bytemuck::cast_slice(&starts));
+        let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&refs));
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: PARAMS_STRIDE * MAX_BATCH as u64,
@@ -203,6 +208,8 @@ impl World {
                 &contacts,
                 &contact_count,
                 &status,
+                &joint_start,
+                &joint_refs,
             ];
             let mut entries = vec![wgpu::BindGroupEntry {
                 binding: 0,
@@ -223,7 +230,7 @@ impl World {
         };
         let bind_groups = [bind_group(0), bind_group(1)];
         gpu.check()?;
-        let others = vec![props_buf, vel0, cell_count, cell_start, block_sums, sorted, large_buf];
+        let others = vec![props_buf, vel0, cell_count, cell_start, block_sums, sorted, large_buf, joint_start, joint_refs];
         let data = WorldData { states: state_bufs, params, status, contacts, contact_count, bind_groups, _others: others };
         let substep_dt = settings.dt / settings.substeps as f32;
         Ok(World {
@@ -565,6 +572,51 @@ pub fn body_output(s: &BodyState, dt: f64) -> BodyOutput {
         linear_velocity: v.as_vec3().to_array(),
         angular_velocity: w.as_vec3().to_array(),
     }
+}
+
+/// Each body's ball-joint ends, as CSR lists: body i's are
+/// `refs[starts[i]..starts[i + 1]]`, in the order the joints are listed.
+pub fn joint_lists(scene: &Scene) -> (Vec<u32>, Vec<JointRef>) {
+    let n = scene.bodies.len();
+    let mut per_body: Vec<Vec<JointRef>> = vec![Vec::new(); n];
+    let side = |body: i32| if body < 0 { WORLD } else { body as u32 };
+    for j in &scene.joints {
+        for (me, other) in [(0, 1), (1, 0)] {
+            if j.bodies[me] >= 0 {
+                per_body[j.bodies[me] as usize].push(JointRef {
+                    local_self: j.anchors[me],
+                    partner: side(j.bodies[other]),
+                    local_partner: j.anchors[other],
+                    _pad0: 0,
+                });
+            }
+        }
+    }
+    let mut starts = Vec::with_capacity(n + 1);
+    let mut refs = Vec::new();
+    for list in per_body {
+        starts.push(refs.len() as u32);
+        refs.extend(list);
+    }
+    starts.push(refs.len() as u32);
+    (starts, refs)
+}
+
+/// How far each joint has opened (m): the distance between its two anchors.
+pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
+    let anchor = |body: i32, local: [f32; 3]| -> DVec3 {
+        let l = DVec3::new(local[0] as f64, local[1] as f64, local[2] as f64);
+        if body < 0 {
+            return l;
+        }
+        let s = &states[body as usize];
+        dvec(s.pos) + dquat(s.rot).normalize() * l
+    };
+    scene
+        .joints
+        .iter()
+        .map(|j| (anchor(j.bodies[0], j.anchors[0]) - anchor(j.bodies[1], j.anchors[1])).length() as f32)
+        .collect()
 }
 
 /// The GPU record of a body's shape, mass and material.

@@ -43,6 +43,7 @@ fn shared_structs_match_member_by_member() {
             substeps, _pad1, _pad2
         }
     );
+    check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });
     check_layout!(common, Contact { local_self, partner, local_partner, pushed, normal, _pad1 });
 }
 
@@ -62,6 +63,7 @@ fn constants_match() {
     assert_eq!(find("WORKGROUP"), WORKGROUP);
     assert_eq!(find("MAX_CONTACTS"), MAX_CONTACTS);
     assert_eq!(find("GROUND"), GROUND);
+    assert_eq!(find("WORLD"), WORLD);
     let grid = format!("{}{}{}", shaders::COMMON, shaders::BINDINGS, shaders::GRID);
     let module = shaders::validate(&grid).unwrap();
     let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some("SCAN_BLOCK")).unwrap();

@@ -84,6 +84,21 @@ pub struct Contact {
     pub _pad1: u32,
 }
 
+/// One end of a ball joint as the body at that end sees it (32 bytes): its
+/// anchor in its own frame, and the partner's anchor in the partner's frame
+/// (in world coordinates when the partner is `WORLD`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct JointRef {
+    pub local_self: [f32; 3],
+    pub partner: u32,
+    pub local_partner: [f32; 3],
+    pub _pad0: u32,
+}
+
+/// The partner of a joint pinned to the world (`WORLD` in WGSL).
+pub const WORLD: u32 = u32::MAX;
+
 /// The partner of a contact with the ground (`GROUND` in WGSL).
 pub const GROUND: u32 = u32::MAX;
 

@@ -87,9 +87,9 @@ impl Stage {
     }
 }
 
-/// Storage buffers the step's bind group holds (bindings 1-12 of
+/// Storage buffers the step's bind group holds (bindings 1-14 of
 /// shaders/bindings.wgsl); the device must allow this many per stage.
-pub const STORAGE_BUFFERS: u32 = 12;
+pub const STORAGE_BUFFERS: u32 = 14;
 
 pub struct StepPipelines {
     pub layout: wgpu::BindGroupLayout,
@@ -123,7 +123,7 @@ impl StepPipelines {
             },
             count: None,
         }];
-        let read_only = [1, 2, 9]; // props, state_in, large
+        let read_only = [1, 2, 9, 13, 14]; // props, state_in, large, joint_start, joint_refs
         for binding in 1..=STORAGE_BUFFERS {
             entries.push(storage(binding, read_only.contains(&binding)));
         }

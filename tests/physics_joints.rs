@@ -1,0 +1,177 @@
+//! Ball joints (issue 4): a chain that swings and comes to rest, a pendulum
+//! with the compound-pendulum period, a loaded bridge, ragdolls on a pile.
+
+mod common;
+
+use common::{quat, v3, world};
+use glam::{Quat, Vec3};
+use verlet::scenes::{self, box_body};
+use verlet::world::joint_gaps;
+use verlet::{Joint, Scene};
+
+/// Kinetic energy (J) of every body from the implied velocities.
+fn kinetic_energy(scene: &Scene, state: &[verlet::BodyOutput]) -> f64 {
+    scene
+        .bodies
+        .iter()
+        .zip(state)
+        .filter(|(b, _)| !b.fixed)
+        .map(|(b, s)| {
+            let v = v3(s.linear_velocity).as_dvec3();
+            let q = Quat::from_array(s.orientation).as_dquat();
+            let w_local = q.conjugate() * v3(s.angular_velocity).as_dvec3();
+            let ii = b.inverse_inertia();
+            let inertia = glam::DVec3::new(1.0 / ii[0] as f64, 1.0 / ii[1] as f64, 1.0 / ii[2] as f64);
+            0.5 * b.mass as f64 * v.length_squared() + 0.5 * (inertia * w_local * w_local).element_sum()
+        })
+        .sum()
+}
+
+#[test]
+fn a_chain_of_21_links_swings_and_comes_to_rest_hanging() {
+    let scene = scenes::chain(21);
+    let Some(mut w) = world(&scene) else { return };
+    let (mut worst_gap, mut peak, mut last) = (0.0f32, 0.0f64, 0.0f64);
+    let mut rest_at = None;
+    for step in 1..=1800u32 {
+        w.step(1).unwrap();
+        let raw = w.read_raw().unwrap();
+        if step > 60 {
+            worst_gap = worst_gap.max(joint_gaps(&scene, &raw).into_iter().fold(0.0, f32::max));
+        }
+        let ke = kinetic_energy(&scene, &w.read_state().unwrap());
+        peak = peak.max(ke);
+        last = ke;
+        if rest_at.is_none() && step > 120 && ke < 0.01 * peak {
+            rest_at = Some(step as f32 / 60.0);
+        }
+        if rest_at.is_some() && ke >= 0.01 * peak {
+            rest_at = None;
+        }
+    }
+    let end = w.read_state().unwrap();
+    let lowest = end.iter().map(|b| b.position[1]).fold(f32::MAX, f32::min);
+    eprintln!("chain of 21: worst joint gap after 1 s {worst_gap} m; KE peak {peak:.2} J, final {last:.4} J; at rest from {rest_at:?} s; lowest link at y = {lowest}");
+    assert!(worst_gap < 0.01, "a joint opened {worst_gap} m");
+    assert!(rest_at.is_some(), "still moving after 30 s: KE {last} J of peak {peak} J");
+    // hanging: the free end far below the pin
+    assert!(lowest < 23.0 - 19.0, "the chain does not hang: lowest link at {lowest}");
+}
+
+#[test]
+fn a_pendulum_swings_with_the_compound_pendulum_period() {
+    let mut scene = scenes::stack(0);
+    scene.ground = None;
+    let angle = 10f32.to_radians();
+    let pivot = Vec3::new(0.0, 5.0, 0.0);
+    let tilt = Quat::from_rotation_z(angle);
+    let centre = pivot + tilt * Vec3::new(0.0, -0.5, 0.0);
+    let mut bob = box_body([0.1, 0.5, 0.1], centre.to_array());
+    bob.orientation = tilt.to_array();
+    scene.bodies.push(bob);
+    scene.joints.push(Joint { bodies: [0, -1], anchors: [[0.0, 0.5, 0.0], pivot.to_array()] });
+    let Some(mut w) = world(&scene) else { return };
+    // upward zero crossings of x, timed by linear interpolation
+    let mut crossings = Vec::new();
+    let mut prev_x = w.read_state().unwrap()[0].position[0] as f64;
+    for _ in 0..600 {
+        w.step(1).unwrap();
+        let x = w.read_state().unwrap()[0].position[0] as f64;
+        if prev_x < 0.0 && x >= 0.0 {
+            let t = w.time() - (1.0 / 60.0) * x / (x - prev_x);
+            crossings.push(t);
+        }
+        prev_x = x;
+    }
+    assert!(crossings.len() >= 4, "only {} swings in 10 s", crossings.len());
+    let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+    // I about the pivot = m (b^2 + c^2) / 12 + m d^2 for a 0.2 x 1 x 0.2 box, d = 0.5
+    let theory = 2.0 * std::f64::consts::PI * ((0.04 + 1.0) / 12.0 + 0.25f64).sqrt() / (9.81f64 * 0.5).sqrt();
+    eprintln!("pendulum: period {period:.4} s over {} swings, theory {theory:.4} s", crossings.len() - 1);
+    assert!((period - theory).abs() < 0.02 * theory, "period {period}, theory {theory}");
+}
+
+#[test]
+fn a_bridge_holds_ten_boxes() {
+    let mut scene = scenes::bridge(20);
+    for k in 0..10 {
+        scene.bodies.push(box_body([0.3; 3], [1.0 + k as f32 * 2.0, 5.0 + (k % 3) as f32, 0.0]));
+    }
+    let Some(mut w) = world(&scene) else { return };
+    let mut worst = 0.0f32;
+    for _ in 0..60 {
+        w.step(10).unwrap();
+        worst = worst.max(joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max));
+    }
+    let state = w.read_state().unwrap();
+    let boxes_on_bridge = state[state.len() - 10..].iter().filter(|b| b.position[1] > 1.0).count();
+    eprintln!("bridge: worst joint gap {worst} m; {boxes_on_bridge} of 10 boxes above 1 m");
+    assert!(worst < 0.02, "a bridge joint opened {worst} m");
+    assert_eq!(boxes_on_bridge, 10, "boxes fell through the bridge");
+}
+
+#[test]
+fn ten_ragdolls_come_to_rest_on_a_pile() {
+    let scene = scenes::ragdoll(10);
+    let Some(mut w) = world(&scene) else { return };
+    let mut worst = 0.0f32;
+    for _ in 0..60 {
+        w.step(10).unwrap();
+        worst = worst.max(joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max));
+    }
+    let state = w.read_state().unwrap(); // refuses NaN
+    let fastest = state.iter().map(|b| v3(b.linear_velocity).length()).fold(0.0, f32::max);
+    eprintln!("ragdolls: worst joint gap {worst} m, fastest body after 10 s {fastest} m/s");
+    assert!(worst < 0.02, "a ragdoll joint opened {worst} m");
+    assert!(fastest < 0.1, "ragdolls still moving at {fastest} m/s");
+}
+
+/// The catenary through (-d/2, 0) and (d/2, 0) with arc length `s`: the
+/// height below the pins at x, from 2 a sinh(d / 2a) = s solved by bisection.
+fn catenary(s: f64, d: f64) -> impl Fn(f64) -> f64 {
+    let (mut lo, mut hi) = (1e-3 * d, 1e3 * d); // the arc shrinks as a grows
+    for _ in 0..200 {
+        let a = 0.5 * (lo + hi);
+        if 2.0 * a * (d / (2.0 * a)).sinh() > s {
+            lo = a;
+        } else {
+            hi = a;
+        }
+    }
+    let a = 0.5 * (lo + hi);
+    move |x: f64| a * ((x / a).cosh() - (d / (2.0 * a)).cosh())
+}
+
+#[test]
+fn a_chain_hung_by_both_ends_settles_into_a_catenary() {
+    let links = 20;
+    let scene = scenes::hanging(links);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(1200).unwrap(); // 20 s
+    let state = w.read_state().unwrap();
+    let fastest = state.iter().map(|b| v3(b.linear_velocity).length()).fold(0.0, f32::max);
+    // the pins, and every joint between two links, should lie on the curve
+    let pins = [scene.joints[0].anchors[1], scene.joints[links].anchors[1]];
+    let (left, right) = (Vec3::from(pins[0]), Vec3::from(pins[1]));
+    let span = (right - left).length() as f64;
+    let curve = catenary(links as f64, span);
+    let centre_x = 0.5 * (left.x + right.x) as f64;
+    let mut worst = 0.0f64;
+    let mut worst_gap = 0.0f32;
+    for k in 0..links {
+        let s = &state[k];
+        let end = v3(s.position) + quat(s.orientation) * Vec3::new(0.5, 0.0, 0.0);
+        let want = left.y as f64 + curve(end.x as f64 - centre_x);
+        worst = worst.max((end.y as f64 - want).abs());
+        worst = worst.max(end.z.abs() as f64);
+    }
+    worst_gap = worst_gap.max(joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max));
+    let sag = -curve(0.0);
+    eprintln!(
+        "hanging chain of {links}: span {span} m, catenary sag {sag:.3} m; largest deviation {worst:.4} m = {:.2}% of the span; \
+         widest joint gap {worst_gap} m; fastest link {fastest} m/s",
+        100.0 * worst / span
+    );
+    assert!(fastest < 0.05, "still moving at {fastest} m/s");
+    assert!(worst < 0.02 * span, "deviates {worst} m from the catenary (span {span} m)");
+}
