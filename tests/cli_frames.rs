@@ -1,0 +1,125 @@
+//! `verlet run --frames`: the binary writes the frames INTERFACE.md section 3
+//! promises, and refuses bad image flags cleanly.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// A fresh, empty directory under the system temp dir, unique to this test.
+fn temp_dir(name: &str) -> PathBuf {
+    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos());
+    let dir = std::env::temp_dir().join(format!("verlet-cli-frames-{name}-{}-{nanos}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn verlet(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_verlet")).args(args).output().expect("the verlet binary runs")
+}
+
+/// True when the run failed only for want of an adapter: a loud skip, or a
+/// failure under CI (as tests/common/mod.rs does for the library tests).
+fn no_adapter(output: &Output) -> bool {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if output.status.success() || !stderr.contains("no GPU adapter found") {
+        return false;
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!("CI is set but the binary found no GPU adapter: {stderr}");
+    }
+    eprintln!("\n!!!!! SKIPPING GPU TEST: the binary found no adapter ({}) !!!!!\n", stderr.trim());
+    true
+}
+
+#[test]
+fn frames_are_written_every_k_steps_at_the_asked_size() {
+    let dir = temp_dir("drop");
+    let out = verlet(&[
+        "run", "--builtin", "drop", "--steps", "20", "--every", "10", "--frames", dir.to_str().unwrap(),
+        "--width", "333", "--height", "211",
+    ]);
+    if no_adapter(&out) {
+        return;
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "verlet run failed: {stderr}");
+
+    // steps 0, 10 and 20: exactly three frames, numbered in sequence
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("the frames directory exists")
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["frame_000000.png", "frame_000001.png", "frame_000002.png"]);
+
+    let frames: Vec<image::RgbaImage> =
+        names.iter().map(|n| image::open(dir.join(n)).expect("a readable PNG").to_rgba8()).collect();
+    for (name, f) in names.iter().zip(&frames) {
+        assert_eq!(f.dimensions(), (333, 211), "{name}");
+    }
+    // the box falls: each frame shows it somewhere else
+    for k in 1..frames.len() {
+        assert_ne!(frames[k - 1].as_raw(), frames[k].as_raw(), "{} and {} are identical", names[k - 1], names[k]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn gif_and_contact_sheet_without_frames() {
+    let dir = temp_dir("gif");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (gif, sheet) = (dir.join("run.gif"), dir.join("sheet.png"));
+    let out = verlet(&[
+        "run", "--builtin", "drop", "--steps", "30", "--every", "10", "--gif", gif.to_str().unwrap(),
+        "--contact-sheet", sheet.to_str().unwrap(), "--width", "160", "--height", "120",
+    ]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "verlet run failed: {}", String::from_utf8_lossy(&out.stderr));
+    let decoder = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(std::fs::File::open(&gif).unwrap()))
+        .expect("a readable GIF");
+    let frames = image::AnimationDecoder::into_frames(decoder).collect_frames().expect("GIF frames decode");
+    assert_eq!(frames.len(), 4, "steps 0, 10, 20, 30");
+    assert_eq!(frames[0].buffer().dimensions(), (160, 120));
+    // 4 tiles: 2 x 2 with 2-pixel gutters
+    let sheet = image::open(&sheet).expect("a readable PNG");
+    assert_eq!((sheet.width(), sheet.height()), (2 * 160 + 3 * 2, 2 * 120 + 3 * 2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_image_flags_are_refused_naming_the_flag() {
+    let dir = temp_dir("refused");
+    let dir_arg = dir.to_str().unwrap();
+    for (flag, args) in [
+        ("--width", vec!["--width", "0"]),
+        ("--height", vec!["--height", "0"]),
+        ("--width", vec!["--width=-5"]),
+        ("--every", vec!["--every", "0"]),
+    ] {
+        let mut all = vec!["run", "--builtin", "drop", "--steps", "5", "--frames", dir_arg];
+        all.extend(args.iter().copied());
+        let out = verlet(&all);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}: exit status 0");
+        assert!(!stderr.contains("panicked"), "{args:?}: panicked: {stderr}");
+        assert!(stderr.contains(flag), "{args:?}: expected {flag} in {stderr:?}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: not one line: {stderr:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_unwritable_frames_directory_is_refused_naming_the_flag() {
+    // a directory cannot be made inside a regular file
+    let file = temp_dir("file");
+    std::fs::write(&file, b"not a directory").unwrap();
+    let inside = file.join("frames");
+    let out = verlet(&["run", "--builtin", "drop", "--steps", "5", "--frames", inside.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(stderr.contains("--frames") && stderr.contains(inside.to_str().unwrap()), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "not one line: {stderr:?}");
+    let _ = std::fs::remove_file(&file);
+}
