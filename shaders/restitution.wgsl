@@ -1,12 +1,18 @@
 // Pass "restitution", once per substep after the solve: collisions change
 // velocity by rewriting the previous pose (the paper, section III). A contact
-// that was approaching faster than a resting contact can (2 |g| dt) leaves
-// with -e times its approach speed along the normal; slower ones stay at
-// rest, so resting bodies do not hop. Dynamic friction acts here too: a
+// that was approaching faster than a resting contact can (2 |g| dt), and
+// faster than RESTITUTION_THRESHOLD, leaves with -e times its approach speed
+// along the normal; slower ones stay at rest, so resting bodies do not hop.
+// The floor matters with substeps: at dt = 1/480 s, 2 |g| dt is 4 cm/s, and
+// a limb held against a surface by a joint then bounced every substep and
+// pumped energy in (a ragdoll's forearm jittered forever). Dynamic friction acts here too: a
 // contact still sliding after the solve loses up to mu times the normal
 // velocity change its push made (mu |dv_n|, Coulomb's law per substep).
 // Every contact is measured on the velocities after the solve and the
 // changes summed, the turns split among the contacts as in the solve.
+
+// Approach speeds (m/s) below this never bounce; Box2D's default too.
+const RESTITUTION_THRESHOLD: f32 = 1.0;
 
 // Velocities a pose implies: (x - x_prev) / dt and the rotation q q_prev^*.
 fn implied_velocity(s: BodyState) -> Velocity {
@@ -34,7 +40,7 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let before = vel0[i];
     let now = implied_velocity(s);
-    let threshold = 2.0 * length(params.gravity.xyz) * params.dt;
+    let threshold = max(2.0 * length(params.gravity.xyz) * params.dt, RESTITUTION_THRESHOLD);
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
