@@ -9,6 +9,7 @@ use crate::gpu::{types::*, Gpu};
 use crate::scene::{Body, Scene, Settings, Shape};
 use crate::step::{Over, Stage, StepPipelines, STORAGE_BUFFERS};
 use crate::Error;
+pub mod snapshot;
 
 /// Steps encoded into one submission; each gets its own `Params` slot.
 const MAX_BATCH: usize = 64;

@@ -1,0 +1,251 @@
+//! Snapshots: a world's whole dynamic state (the current poses with their
+//! previous poses, the step counter, the time and the last substep's length),
+//! taken and restored through the API or a small binary file.
+//!
+//! What carries over from one step to the next is exactly this: every pass
+//! that writes poses writes every body's slot of the other pose buffer, so
+//! the buffer that is not current is overwritten before it is read; the
+//! contact lists are rebuilt by each step's narrowphase (their `pushed`
+//! budgets are reset by the integration pass), and the velocities the
+//! restitution pass compares against are written by that step's integration.
+//! Restoring the poses and `dt_prev` therefore continues bit for bit as the
+//! run the snapshot was taken from (tests/snapshot.rs checks it).
+//!
+//! A snapshot names the scene it belongs to by a hash of the world's static
+//! data (settings, ground, grid, the bodies' shapes, masses and materials,
+//! and the joints), and restoring it into another scene is refused.
+//!
+//! # File format (version 1, little-endian)
+//!
+//! | offset | size | field |
+//! |-------:|-----:|-------|
+//! | 0 | 8 | magic `VRLTSNAP` |
+//! | 8 | 4 | version (u32) = 1 |
+//! | 12 | 4 | body count n (u32) |
+//! | 16 | 8 | step counter (u64) |
+//! | 24 | 8 | simulated time, s (f64) |
+//! | 32 | 4 | last substep's length, s (f32) |
+//! | 36 | 4 | reserved, 0 |
+//! | 40 | 8 | scene hash (u64) |
+//! | 48 | 64 n | poses: `BodyState` as on the GPU |
+//! | 48 + 64 n | 8 | FNV-1a 64 of all bytes before it |
+//!
+//! 56 bytes plus 64 bytes per body.
+
+use std::path::Path;
+
+use super::World;
+use crate::gpu::types::BodyState;
+use crate::Error;
+
+const MAGIC: &[u8; 8] = b"VRLTSNAP";
+const VERSION: u32 = 1;
+const HEADER: usize = 48;
+const TRAILER: usize = 8;
+const POSE: usize = std::mem::size_of::<BodyState>();
+
+/// The dynamic state of a world at one step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    step: u64,
+    time: f64,
+    dt_prev: f32,
+    scene_hash: u64,
+    states: Vec<BodyState>,
+}
+
+impl Snapshot {
+    /// Steps the world had taken.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Length of the last substep taken (s).
+    pub fn dt_prev(&self) -> f32 {
+        self.dt_prev
+    }
+
+    pub fn body_count(&self) -> usize {
+        self.states.len()
+    }
+
+    /// The hash of the static data of the scene this snapshot belongs to.
+    pub fn scene_hash(&self) -> u64 {
+        self.scene_hash
+    }
+
+    /// The poses, as `World::read_raw` gives them.
+    pub fn states(&self) -> &[BodyState] {
+        &self.states
+    }
+
+    /// The file format of the module documentation.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(HEADER + POSE * self.states.len() + TRAILER);
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&(self.states.len() as u32).to_le_bytes());
+        out.extend_from_slice(&self.step.to_le_bytes());
+        out.extend_from_slice(&self.time.to_le_bytes());
+        out.extend_from_slice(&self.dt_prev.to_le_bytes());
+        out.extend_from_slice(&0u32.to_le_bytes());
+        out.extend_from_slice(&self.scene_hash.to_le_bytes());
+        for s in &self.states {
+            for v in s.pos.iter().chain(&s.prev_pos).chain(&s.rot).chain(&s.prev_rot) {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        let sum = fnv1a(FNV_OFFSET, &out);
+        out.extend_from_slice(&sum.to_le_bytes());
+        out
+    }
+
+    /// Parses the file format; anything else is refused with the reason.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Snapshot, String> {
+        if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+            return Err("not a verlet snapshot (no VRLTSNAP header)".into());
+        }
+        if bytes.len() < HEADER + TRAILER {
+            return Err(format!("truncated snapshot: {} bytes, a header alone takes {}", bytes.len(), HEADER + TRAILER));
+        }
+        let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+        let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+        let f32_at = |at: usize| f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+        let version = u32_at(8);
+        if version != VERSION {
+            return Err(format!("snapshot version {version} is not supported (this build reads version {VERSION})"));
+        }
+        let n = u32_at(12) as usize;
+        let expected = n.checked_mul(POSE).and_then(|p| p.checked_add(HEADER + TRAILER));
+        if expected != Some(bytes.len()) {
+            return Err(format!(
+                "snapshot of {n} bodies should be {} bytes but is {} (truncated or padded)",
+                expected.map_or("too many".to_string(), |e| e.to_string()),
+                bytes.len()
+            ));
+        }
+        let body_end = bytes.len() - TRAILER;
+        let stored = u64_at(body_end);
+        let actual = fnv1a(FNV_OFFSET, &bytes[..body_end]);
+        if stored != actual {
+            return Err(format!("snapshot is corrupt: checksum {stored:016x} stored, {actual:016x} computed"));
+        }
+        let step = u64_at(16);
+        let time = f64::from_bits(u64_at(24));
+        let dt_prev = f32_at(32);
+        if !(time.is_finite() && time >= 0.0) {
+            return Err(format!("snapshot time {time} is not a non-negative finite number"));
+        }
+        if !(dt_prev.is_finite() && dt_prev > 0.0) {
+            return Err(format!("snapshot dt_prev {dt_prev} is not a positive finite number"));
+        }
+        let scene_hash = u64_at(40);
+        let states = (0..n)
+            .map(|i| {
+                let at = HEADER + i * POSE;
+                let v4 = |k: usize| std::array::from_fn(|c| f32_at(at + 16 * k + 4 * c));
+                BodyState { pos: v4(0), prev_pos: v4(1), rot: v4(2), prev_rot: v4(3) }
+            })
+            .collect();
+        Ok(Snapshot { step, time, dt_prev, scene_hash, states })
+    }
+
+    /// Writes the snapshot to `path`.
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<(), Error> {
+        let path = path.as_ref();
+        std::fs::write(path, self.to_bytes()).map_err(|source| Error::Io { path: path.display().to_string(), source })
+    }
+
+    /// Reads a snapshot written by `write`; a file that is not one, or is
+    /// truncated or corrupt, is refused with the reason.
+    pub fn read(path: impl AsRef<Path>) -> Result<Snapshot, Error> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.display().to_string(), source })?;
+        Snapshot::from_bytes(&bytes).map_err(|why| Error::Input(format!("{}: {why}", path.display())))
+    }
+}
+
+impl World {
+    /// The world's dynamic state (a blocking readback of the current poses).
+    pub fn snapshot(&self) -> Result<Snapshot, Error> {
+        let states = self.read_raw()?;
+        Ok(Snapshot { step: self.step, time: self.time, dt_prev: self.dt_prev, scene_hash: self.scene_hash()?, states })
+    }
+
+    /// Puts the world back in the state of `snapshot`, which must have been
+    /// taken from a world of the same scene; stepping on from here gives
+    /// bit for bit what the original world gave.
+    pub fn restore(&mut self, snapshot: &Snapshot) -> Result<(), Error> {
+        if snapshot.states.len() != self.body_count as usize {
+            return Err(Error::Input(format!(
+                "snapshot has {} bodies but this world has {}: it belongs to another scene",
+                snapshot.states.len(),
+                self.body_count
+            )));
+        }
+        let hash = self.scene_hash()?;
+        if snapshot.scene_hash != hash {
+            return Err(Error::Input(format!(
+                "snapshot belongs to another scene (scene hash {:016x}, this world's {hash:016x})",
+                snapshot.scene_hash
+            )));
+        }
+        if !(snapshot.dt_prev.is_finite() && snapshot.dt_prev > 0.0) {
+            return Err(Error::Input(format!("snapshot dt_prev {} is not a positive finite number", snapshot.dt_prev)));
+        }
+        if !snapshot.states.is_empty() {
+            self.gpu.queue.write_buffer(&self.data.states[self.current], 0, bytemuck::cast_slice(&snapshot.states));
+        }
+        self.gpu.check()?;
+        self.step = snapshot.step;
+        self.time = snapshot.time;
+        self.dt_prev = snapshot.dt_prev;
+        Ok(())
+    }
+
+    /// FNV-1a 64 of what a world never changes after start-up: settings,
+    /// ground, grid, and the GPU's copies of the body properties, the
+    /// out-of-grid list and the joint lists (read back).
+    fn scene_hash(&self) -> Result<u64, Error> {
+        let s = &self.settings;
+        let mut h = FNV_OFFSET;
+        let mut put = |bytes: &[u8]| h = fnv1a(h, bytes);
+        put(&self.body_count.to_le_bytes());
+        for v in [s.dt, s.gravity[0], s.gravity[1], s.gravity[2], s.relaxation, s.linear_damping, s.angular_damping, s.restitution, s.friction] {
+            put(&v.to_bits().to_le_bytes());
+        }
+        put(&s.iterations.to_le_bytes());
+        put(&s.substeps.to_le_bytes());
+        match self.ground {
+            Some(g) => put(&[&[1u8][..], &g.to_bits().to_le_bytes()].concat()),
+            None => put(&[0u8]),
+        }
+        put(&self.grid.cell_size.to_bits().to_le_bytes());
+        put(&self.grid.hash_size.to_le_bytes());
+        put(&self.grid.speculative.to_bits().to_le_bytes());
+        put(&self.large_count.to_le_bytes());
+        // `_others` holds, in this order: props, vel0, four grid buffers,
+        // the large list, joint starts, joint refs; the static ones are 0, 6, 7, 8.
+        for k in [0usize, 6, 7, 8] {
+            if let Some(buf) = self.data._others.get(k) {
+                put(&self.gpu.read_buffer(buf, buf.size())?);
+            }
+        }
+        Ok(h)
+    }
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
