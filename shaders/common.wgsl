@@ -65,6 +65,10 @@ struct Contact {
 // about five neighbours with up to four points each.
 const MAX_CONTACTS: u32 = 24u;
 
+// Fastest speed (m/s) at which the solve pushes apart bodies that already
+// overlapped at their previous poses (Box2D's contact push speed is 3 m/s).
+const MAX_DEPENETRATION_SPEED: f32 = 3.0;
+
 // Points closer than this (m) still count as touching when restitution is
 // decided after the solve.
 const CONTACT_SLOP: f32 = 0.002;

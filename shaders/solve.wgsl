@@ -29,7 +29,14 @@ fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact)
     let o = partner_point(c);
     let n = c.normal;
     let r = quat_rotate(s.rot, c.local_self);
-    let depth = dot(o.point - (s.pos.xyz + r), n);
+    let self_before = s.prev_pos.xyz + quat_rotate(s.prev_rot, c.local_self);
+    // Overlap the bodies already had at their previous poses is pushed out at
+    // no more than MAX_DEPENETRATION_SPEED: a full snap in one substep would
+    // turn into that much velocity (Verlet), and deep overlaps (thin limbs
+    // passing through each other, bodies placed overlapping) launched bodies
+    // at tens of m/s. Overlap made by this substep's approach is removed whole.
+    let overlap_before = dot(o.before - self_before, n);
+    let depth = dot(o.point - (s.pos.xyz + r), n) - max(overlap_before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
     // a contact that pushed earlier in this substep keeps its friction while
     // it still touches, even once its depth is resolved, so sideways pushes
     // from other contacts in later iterations are resisted too
@@ -40,7 +47,7 @@ fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact)
     } else if (c.pushed <= 0.0 || depth < -CONTACT_SLOP) {
         return 0.0;
     }
-    let slip = (s.pos.xyz + r) - (s.prev_pos.xyz + quat_rotate(s.prev_rot, c.local_self)) - (o.point - o.before);
+    let slip = (s.pos.xyz + r) - self_before - (o.point - o.before);
     let slip_t = slip - n * dot(slip, n);
     let slide = length(slip_t);
     if (slide > 1e-9 && slide <= combined_friction(p, c) * (c.pushed + push)) {
