@@ -32,7 +32,7 @@ use image::RgbaImage;
 
 use crate::gpu::types::{BodyState, SHAPE_BOX, SHAPE_SPHERE};
 use crate::gpu::Gpu;
-use crate::scene::{Scene, Shape, DEFAULT_FOV_Y_DEGREES};
+use crate::scene::{Scene, Shape, DEFAULT_FOV_Y};
 use crate::world::World;
 use crate::Error;
 
@@ -136,8 +136,8 @@ pub struct CameraView {
     pub target: [f32; 3],
     /// Up in the image: +Y, or +Z when looking straight along Y.
     pub up: [f32; 3],
-    /// Vertical field of view (degrees).
-    pub fov_y_degrees: f32,
+    /// Vertical field of view (radians).
+    pub fov_y: f32,
 }
 
 /// Choices that do not change the pipelines.
@@ -812,11 +812,11 @@ fn choose_camera(scene: &Scene, aspect: f32) -> (CameraView, Framing) {
                 position: c.position,
                 target: c.target,
                 up: up_for(forward).to_array(),
-                fov_y_degrees: c.fov_y_degrees,
+                fov_y: c.fov_y,
             }
         }
         None => {
-            let fov_y = DEFAULT_FOV_Y_DEGREES.to_radians();
+            let fov_y = DEFAULT_FOV_Y;
             let fov_x = 2.0 * ((0.5 * fov_y).tan() * aspect).atan();
             // a sphere of radius R fits a cone of half angle a from R / sin(a) away
             let distance = f.radius / (0.5 * fov_y.min(fov_x)).sin() * FRAMING_MARGIN;
@@ -825,7 +825,7 @@ fn choose_camera(scene: &Scene, aspect: f32) -> (CameraView, Framing) {
                 position: position.to_array(),
                 target: f.centre.to_array(),
                 up: up_for(f.centre - position).to_array(),
-                fov_y_degrees: DEFAULT_FOV_Y_DEGREES,
+                fov_y: DEFAULT_FOV_Y,
             }
         }
     };
@@ -841,7 +841,7 @@ fn view_projection(camera: &CameraView, aspect: f32) -> Mat4 {
     let target = Vec3::from_array(camera.target);
     let view = Mat4::look_at_rh(eye, target, Vec3::from_array(camera.up));
     let near = (1e-3 * eye.distance(target)).max(1e-5);
-    let proj = Mat4::perspective_infinite_reverse_rh(camera.fov_y_degrees.to_radians(), aspect, near);
+    let proj = Mat4::perspective_infinite_reverse_rh(camera.fov_y, aspect, near);
     proj * view
 }
 

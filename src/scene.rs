@@ -43,8 +43,10 @@ pub const MAX_ITERATIONS: u32 = 256;
 /// The most substeps a step may ask for.
 pub const MAX_SUBSTEPS: u32 = 64;
 
-/// Camera vertical field of view used when a `camera` block gives no `fov_y`.
-pub const DEFAULT_FOV_Y_DEGREES: f32 = 45.0;
+/// Camera vertical field of view (radians) used when a `camera` block gives
+/// no `fov_y`: 45 degrees, a natural-looking lens that neither distorts nor
+/// flattens much.
+pub const DEFAULT_FOV_Y: f32 = std::f32::consts::FRAC_PI_4;
 
 /// A quaternion whose length is below this is refused: it has no direction
 /// to normalise to.
@@ -302,17 +304,16 @@ pub struct Joint {
 
 /// A fixed camera for rendering frames (extension to the contract).
 ///
-/// In JSON: `{"position": [..], "target": [..], "fov_y": 45}`, where `fov_y`
-/// is optional.
+/// In JSON: `{"position": [..], "target": [..], "fov_y": 0.785}`, where
+/// `fov_y` (radians, like every angle of the contract) is optional.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position in metres, world frame.
     pub position: [f32; 3],
     /// The point looked at, world frame. Must differ from `position`.
     pub target: [f32; 3],
-    /// Vertical field of view in degrees, in (0, 180); default 45, a
-    /// natural-looking lens that neither distorts nor flattens much.
-    pub fov_y_degrees: f32,
+    /// Vertical field of view in radians, in (0, pi); default `DEFAULT_FOV_Y`.
+    pub fov_y: f32,
 }
 
 /// Why a scene could not be loaded. The message fits on one line: the
@@ -797,7 +798,7 @@ impl RawCamera {
         Ok(Camera {
             position,
             target,
-            fov_y_degrees: self.fov_y.unwrap_or(DEFAULT_FOV_Y_DEGREES),
+            fov_y: self.fov_y.unwrap_or(DEFAULT_FOV_Y),
         })
     }
 }
@@ -993,12 +994,12 @@ fn validate_camera(camera: &Camera) -> Result<(), SceneError> {
             ),
         ));
     }
-    let fov = camera.fov_y_degrees;
+    let fov = camera.fov_y;
     check_finite(fov, "camera.fov_y")?;
-    if !(fov > 0.0 && fov < 180.0) {
+    if !(fov > 0.0 && fov < std::f32::consts::PI) {
         return Err(SceneError::invalid(
             "camera.fov_y",
-            format!("must be in (0, 180) degrees, got {}", show(fov)),
+            format!("must be in (0, pi) radians, got {}", show(fov)),
         ));
     }
     Ok(())
@@ -1140,7 +1141,7 @@ impl Scene {
                     "{{ \"position\": {}, \"target\": {}, \"fov_y\": {} }}",
                     nums(&camera.position),
                     nums(&camera.target),
-                    num(camera.fov_y_degrees)
+                    num(camera.fov_y)
                 ),
             ));
         }
@@ -1442,7 +1443,7 @@ mod tests {
             (r#"{"ground": {}}"#.to_string(), "ground.height: is required but missing"),
             (r#"{"ground": {"height": 1, "normal": [0, 1, 0]}}"#.to_string(), "ground.normal: unknown field"),
             (r#"{"camera": {"position": [1, 1, 1], "target": [1, 1, 1]}}"#.to_string(), "camera.target: must differ"),
-            (r#"{"camera": {"position": [1, 1, 1], "target": [0, 0, 0], "fov_y": 180}}"#.to_string(), "camera.fov_y: must be in (0, 180)"),
+            (r#"{"camera": {"position": [1, 1, 1], "target": [0, 0, 0], "fov_y": 3.2}}"#.to_string(), "camera.fov_y: must be in (0, pi)"),
             (r#"{"camera": {"target": [0, 0, 0]}}"#.to_string(), "camera.position: is required"),
             (r#"{"joints": [{"type": "hinge", "bodies": [0, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(), "joints[0].type: unknown joint type \"hinge\""),
             (r#"{"joints": [{"type": "ball", "bodies": [-1, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(), "joints[0].bodies: both sides are the world"),

@@ -157,7 +157,7 @@ fn silhouette_lands_where_the_camera_projects_it() {
     // a camera far enough that perspective barely shifts the silhouette's
     // centroid from the centre's image, aimed away from the box so it sits
     // off the image's centre
-    scene.camera = Some(Camera { position: [6.0, 7.0, 14.0], target: [0.0, 0.5, 0.0], fov_y_degrees: 30.0 });
+    scene.camera = Some(Camera { position: [6.0, 7.0, 14.0], target: [0.0, 0.5, 0.0], fov_y: 30f32.to_radians() });
     let Some(world) = common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, WIDTH, HEIGHT).unwrap();
     renderer.set_body_color(0, [1.0, 0.0, 0.0]).unwrap();
@@ -183,7 +183,7 @@ fn default_camera_frames_every_body() {
     let Some(world) = common::world(&scene) else { return };
     let renderer = Renderer::new(world.gpu(), &scene, WIDTH, HEIGHT).unwrap();
     let cam = renderer.camera();
-    assert_eq!(cam.fov_y_degrees, 45.0);
+    assert_eq!(cam.fov_y, std::f32::consts::FRAC_PI_4);
     assert_eq!(cam.up, [0.0, 1.0, 0.0]);
     for b in &scene.bodies {
         let r = b.shape.bounding_radius();
@@ -202,7 +202,7 @@ fn default_camera_frames_every_body() {
 #[test]
 fn looking_straight_down_turns_up_to_z() {
     let mut scene = scenes::drop();
-    scene.camera = Some(Camera { position: [0.0, 10.0, 0.0], target: [0.0, 0.0, 0.0], fov_y_degrees: 60.0 });
+    scene.camera = Some(Camera { position: [0.0, 10.0, 0.0], target: [0.0, 0.0, 0.0], fov_y: 60f32.to_radians() });
     let Some(world) = common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, 64, 48).unwrap();
     assert_eq!(renderer.camera().up, [0.0, 0.0, 1.0]);

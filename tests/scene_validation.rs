@@ -146,7 +146,7 @@ const FULL_SCENE: &str = r#"{
     { "type": "ball", "bodies": [-1, 0],
       "anchors": [[-0.5, 3.5, 0.0], [-0.5, 0.25, 0.0]] }
   ],
-  "camera": { "position": [6.0, 4.0, 8.0], "target": [0.0, 1.0, 0.0], "fov_y": 60.0 }
+  "camera": { "position": [6.0, 4.0, 8.0], "target": [0.0, 1.0, 0.0], "fov_y": 1.0 }
 }"#;
 
 #[test]
@@ -172,7 +172,7 @@ fn full_scene_loads() {
     }
     assert_eq!(scene.joints[1].bodies, [WORLD, 0]);
     let camera = scene.camera.expect("camera");
-    assert_eq!(camera.fov_y_degrees, 60.0);
+    assert_eq!(camera.fov_y, 1.0);
 }
 
 #[test]
