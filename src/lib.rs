@@ -15,6 +15,7 @@
 //! # Ok::<(), verlet::Error>(())
 //! ```
 
+pub mod bench;
 pub mod gpu;
 pub mod output;
 pub mod reference;

@@ -37,6 +37,52 @@ enum Command {
     },
     /// The adapter in use, its limits and what a body costs.
     Info,
+    /// Throughput benchmark: named cases, per-stage times, scaling, and the
+    /// rapier3d peer when built with `--features rapier`.
+    Bench(BenchArgs),
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Cases, comma-separated: cubes-1k, cubes-10k, cubes-100k, cubes-1m
+    /// (the adapter's maximum when 1M does not fit), pyramid, chain, or
+    /// SCENE:COUNT. Default: all (with --quick: cubes-1k, cubes-10k, pyramid, chain).
+    #[arg(long, value_delimiter = ',')]
+    cases: Vec<String>,
+    /// Steps per repetition (default 300; 60 with --quick).
+    #[arg(long)]
+    steps: Option<u64>,
+    /// Body-steps per repetition: a case takes min(steps, max(20, this / bodies))
+    /// steps, so large cases finish (default 3000000: 300 steps of 10k cubes; 600000 with --quick).
+    #[arg(long)]
+    body_steps: Option<u64>,
+    /// Repetitions per case, each from the initial state; the median is reported (default 3; 2 with --quick).
+    #[arg(long)]
+    reps: Option<usize>,
+    /// A short run: fewer cases, steps and repetitions.
+    #[arg(long)]
+    quick: bool,
+    /// Steps timed stage by stage after the repetitions (default 10; 3 with --quick; 0: none).
+    #[arg(long)]
+    profile_steps: Option<u64>,
+    /// Write the full report as JSON here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write one CSV row per case here.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Do not run the rapier3d peer even when it is built in.
+    #[arg(long)]
+    no_peer: bool,
+    /// Run the peer only for cases of at most this many bodies.
+    #[arg(long)]
+    peer_max_bodies: Option<usize>,
+    /// Let rapier's bodies sleep (off by default: ours never do).
+    #[arg(long)]
+    rapier_sleeping: bool,
+    /// rapier's num_solver_iterations (default: rapier's own, 4).
+    #[arg(long)]
+    rapier_iterations: Option<usize>,
 }
 
 #[derive(clap::Args)]
@@ -111,6 +157,22 @@ fn main() -> ExitCode {
         Command::Run(args) => run(args),
         Command::Scene { name, count, seed } => print_scene(&name, count, seed),
         Command::Info => info(),
+        Command::Bench(a) => verlet::bench::run(&verlet::bench::Options {
+            cases: a.cases,
+            steps: a.steps,
+            body_steps: a.body_steps,
+            reps: a.reps,
+            quick: a.quick,
+            profile_steps: a.profile_steps,
+            json: a.json,
+            csv: a.csv,
+            no_peer: a.no_peer,
+            peer_max_bodies: a.peer_max_bodies,
+            rapier_sleeping: a.rapier_sleeping,
+            rapier_iterations: a.rapier_iterations,
+            command: std::env::args().collect::<Vec<_>>().join(" "),
+        })
+        .map(|_| ()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

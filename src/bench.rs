@@ -1,0 +1,1293 @@
+//! `verlet bench`: the throughput benchmark (issue 6).
+//!
+//! Named cases (built-in scenes at fixed sizes, shared with `benches/step.rs`)
+//! are each run as:
+//!
+//! 1. **start-up**: the first `World::with_gpu` of the case (pipelines
+//!    compiled — slow on lavapipe, which JIT-compiles every kernel with LLVM —
+//!    and buffers uploaded) and its first step, timed apart from everything
+//!    else and then thrown away;
+//! 2. **repetitions**: `reps` fresh worlds of the same scene, each timed over
+//!    the same `steps` steps from the same initial state (wall clock from the
+//!    first submission to the GPU going idle); the median is reported;
+//! 3. **per stage**: `World::profile` over a few more steps of the last
+//!    repetition's world (GPU timestamp queries where the adapter has them,
+//!    else the wall clock around each pass), a blocking readback of the whole
+//!    state, and for `cubes-1k` an off-screen render at 640 x 480;
+//! 4. **limits**: a memory-bound copy of the state buffer (an inline WGSL
+//!    kernel reading and writing 64 bytes per body, timed like the passes)
+//!    as the physical floor of the integration pass;
+//! 5. **peer** (feature `rapier`): the identical scene stepped the same
+//!    number of steps by rapier3d on the CPU, timed the same way.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::gpu::{types::*, Gpu};
+use crate::render::Renderer;
+use crate::scene::Scene;
+use crate::step::Stage;
+use crate::world::{self, StageTimes, World};
+use crate::{scenes, Error};
+
+/// Seed of every random case, so a case name means one scene.
+pub const SEED: u64 = 1;
+
+/// The named cases: (name, built-in scene, count; `None`: the scene's
+/// default). `cubes-1m` runs at the adapter's maximum when 1M does not fit.
+pub const CASES: &[(&str, &str, Option<usize>)] = &[
+    ("cubes-1k", "cubes", Some(1_000)),
+    ("cubes-10k", "cubes", Some(10_000)),
+    ("cubes-100k", "cubes", Some(100_000)),
+    ("cubes-1m", "cubes", Some(1_000_000)),
+    ("pyramid", "pyramid", Some(20)),
+    ("chain", "chain", Some(21)),
+];
+
+/// The cases `--quick` runs.
+pub const QUICK_CASES: &[&str] = &["cubes-1k", "cubes-10k", "pyramid", "chain"];
+
+/// Steps per repetition unless `--steps` says: the issue's "10 000 cubes
+/// piling up (300 steps)", 5 s of simulated time at 60 Hz.
+pub const DEFAULT_STEPS: u64 = 300;
+pub const QUICK_STEPS: u64 = 60;
+/// Body-steps per repetition unless `--body-steps` says: a case takes
+/// `min(steps, max(MIN_STEPS, body_steps / bodies))` steps, so the large
+/// cases finish (300 steps of 10 000 cubes; 30 of 100 000).
+pub const DEFAULT_BODY_STEPS: u64 = 3_000_000;
+pub const QUICK_BODY_STEPS: u64 = 600_000;
+/// The fewest steps a repetition takes, whatever the budget.
+pub const MIN_STEPS: u64 = 20;
+pub const DEFAULT_REPS: usize = 3;
+pub const QUICK_REPS: usize = 2;
+/// Steps timed stage by stage after the repetitions.
+pub const PROFILE_STEPS: u64 = 10;
+
+/// One benchmark case: a built-in scene at a size.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Case {
+    pub name: String,
+    pub scene: String,
+    pub count: Option<usize>,
+}
+
+impl Case {
+    /// A named case (`CASES`) or `SCENE:COUNT` (`cubes:50000`, `pyramid:30`).
+    pub fn parse(spec: &str) -> Result<Case, Error> {
+        if let Some(&(name, scene, count)) = CASES.iter().find(|c| c.0 == spec) {
+            return Ok(Case { name: name.into(), scene: scene.into(), count });
+        }
+        let (scene, count) = match spec.split_once(':') {
+            Some((s, c)) => {
+                let n: usize = c
+                    .parse()
+                    .ok()
+                    .filter(|&n| n > 0)
+                    .ok_or_else(|| Error::Input(format!("--cases: {spec:?}: the count must be a positive integer")))?;
+                (s, Some(n))
+            }
+            None => (spec, None),
+        };
+        if !scenes::NAMES.iter().any(|(n, _)| *n == scene) {
+            let named: Vec<&str> = CASES.iter().map(|c| c.0).collect();
+            let known: Vec<&str> = scenes::NAMES.iter().map(|c| c.0).collect();
+            return Err(Error::Input(format!(
+                "--cases: unknown case {spec:?}; named cases: {}; or SCENE[:COUNT] with SCENE one of {}",
+                named.join(", "),
+                known.join(", ")
+            )));
+        }
+        let name = match count {
+            Some(n) => format!("{scene}-{n}"),
+            None => scene.to_string(),
+        };
+        Ok(Case { name, scene: scene.into(), count })
+    }
+
+    /// The case's scene.
+    pub fn scene(&self) -> Scene {
+        scenes::by_name(&self.scene, self.count, SEED).expect("Case::parse checked the scene name")
+    }
+}
+
+/// A named case by name (for `benches/step.rs` and tests); panics on an
+/// unknown name.
+pub fn case(name: &str) -> Case {
+    Case::parse(name).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// What `verlet bench` was asked to do.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// Case names or `SCENE:COUNT`; empty: all of `CASES` (`QUICK_CASES` with `quick`).
+    pub cases: Vec<String>,
+    pub steps: Option<u64>,
+    /// Body-steps per repetition (caps the steps of large cases).
+    pub body_steps: Option<u64>,
+    pub reps: Option<usize>,
+    pub quick: bool,
+    pub profile_steps: Option<u64>,
+    pub json: Option<PathBuf>,
+    pub csv: Option<PathBuf>,
+    /// Skip the rapier3d peer even when it is built in.
+    pub no_peer: bool,
+    /// The peer only for cases of at most this many bodies.
+    pub peer_max_bodies: Option<usize>,
+    /// Let rapier's bodies sleep (off by default: our bodies never sleep).
+    pub rapier_sleeping: bool,
+    /// rapier's `num_solver_iterations`; `None`: rapier's default (4).
+    pub rapier_iterations: Option<usize>,
+    /// The command line, recorded in the outputs.
+    pub command: String,
+}
+
+/// Per-stage cost of a step (ms per step, summed over substeps and iterations).
+#[derive(Clone, Debug, Serialize)]
+pub struct Stages {
+    /// "GPU timestamps" or "wall clock per pass".
+    pub source: String,
+    pub steps: u64,
+    /// The seven grid passes together.
+    pub broadphase: f64,
+    pub narrowphase: f64,
+    pub integrate: f64,
+    pub solve: f64,
+    pub restitution: f64,
+    /// Sum of the above.
+    pub total: f64,
+    /// Every pass by its entry point.
+    pub passes: Vec<(String, f64)>,
+}
+
+impl Stages {
+    fn from_times(t: &StageTimes, steps: u64) -> Stages {
+        let get = |s: Stage| t.ms_per_step.iter().find(|(k, _)| *k == s).map_or(0.0, |x| x.1);
+        let broadphase = [
+            Stage::GridClear,
+            Stage::GridCount,
+            Stage::GridScanBlocks,
+            Stage::GridScanSums,
+            Stage::GridScanAdd,
+            Stage::GridScatter,
+            Stage::GridSort,
+        ]
+        .iter()
+        .map(|&s| get(s))
+        .sum::<f64>();
+        let (narrowphase, integrate, solve, restitution) =
+            (get(Stage::Narrowphase), get(Stage::Integrate), get(Stage::Solve), get(Stage::Restitution));
+        Stages {
+            source: if t.gpu_timestamps { "GPU timestamps" } else { "wall clock per pass" }.into(),
+            steps,
+            broadphase,
+            narrowphase,
+            integrate,
+            solve,
+            restitution,
+            total: broadphase + narrowphase + integrate + solve + restitution,
+            passes: t.ms_per_step.iter().map(|(s, ms)| (s.name().to_string(), *ms)).collect(),
+        }
+    }
+}
+
+/// The CPU peer's figures for one case.
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerResult {
+    pub engine: String,
+    pub threads: String,
+    pub sleeping: bool,
+    pub num_solver_iterations: usize,
+    pub setup_s: f64,
+    pub ms_per_step: Vec<f64>,
+    pub median_ms_per_step: f64,
+    pub body_steps_per_s: f64,
+    /// Peer ms/step over ours: above 1, we are faster.
+    pub speedup: f64,
+    /// Mean height of the movable bodies after the last repetition (m).
+    pub mean_height: f64,
+}
+
+/// One case's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseResult {
+    pub case: String,
+    pub scene: String,
+    pub bodies: usize,
+    pub joints: usize,
+    /// Why the case did not run (it does not fit the adapter), if it did not.
+    pub skipped: Option<String>,
+    /// A note on the case (run at a smaller size than named, and why).
+    pub note: Option<String>,
+    pub steps: u64,
+    pub reps: usize,
+    /// The case's first `World::with_gpu` and first step, waited for (s):
+    /// upload, and on lavapipe the JIT compilation of every pipeline, which
+    /// happens at first use (fast when Mesa's on-disk shader cache has them).
+    pub startup_s: f64,
+    /// Of which the first step (ms).
+    pub first_step_ms: f64,
+    /// Median `World::with_gpu` of the repetitions (s), compiled pipelines cached.
+    pub setup_s: f64,
+    pub ms_per_step: Vec<f64>,
+    pub median_ms_per_step: f64,
+    pub body_steps_per_s: f64,
+    /// `world::bytes_per_body() * bodies`.
+    pub gpu_bytes_estimate: u64,
+    /// Every buffer `World::with_gpu` allocates for this scene, sized as it
+    /// sizes them (hash table at its rounded size, params slots, joints).
+    pub gpu_bytes: u64,
+    pub gpu_bytes_per_body: f64,
+    pub stages: Option<Stages>,
+    /// `World::read_state` of every body (ms, median of 3).
+    pub readback_ms: f64,
+    /// `Renderer::new` for the 1000-cube scene at 640 x 480 (s), on the cubes-1k row.
+    pub render_setup_s: Option<f64>,
+    /// `Renderer::render` at 640 x 480 including its image readback (ms, median of 3).
+    pub render_ms: Option<f64>,
+    /// One integrate pass (ms): the profile's integrate time over substeps.
+    pub integrate_ms_per_pass: Option<f64>,
+    /// One pass of the copy kernel over the same number of bodies (ms).
+    pub copy_ms_per_pass: Option<f64>,
+    /// Most contact points one body wanted, and whether any list overflowed.
+    pub max_contacts: u32,
+    pub contacts_overflowed: bool,
+    /// Mean height of the movable bodies after the last repetition (m).
+    pub mean_height: f64,
+    pub peer: Option<PeerResult>,
+}
+
+/// Exponent of time per step against bodies.
+#[derive(Clone, Debug, Serialize)]
+pub struct Scaling {
+    /// The cubes cases fitted: (bodies, ms/step).
+    pub points: Vec<(usize, f64)>,
+    /// Least-squares slope of ln(ms/step) on ln(bodies).
+    pub exponent: f64,
+    /// Largest over smallest cost per body-step among the points.
+    pub spread: f64,
+}
+
+/// A target of issue 6, measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Target {
+    pub target: String,
+    /// `None`: not measured in this run.
+    pub met: Option<bool>,
+    pub measured: String,
+}
+
+/// Everything `verlet bench` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub command: String,
+    pub cpu: String,
+    pub cores: usize,
+    pub adapter: String,
+    pub gpu_timestamps: bool,
+    pub max_bodies: u64,
+    pub max_storage_buffer_binding_size: u64,
+    pub bytes_per_body: u64,
+    /// How our iteration counts compare with the peer's, in words.
+    pub iterations: String,
+    pub peer: String,
+    pub gpu_open_s: f64,
+    /// `Renderer::new` for the 1000-cube scene at 640 x 480 (s).
+    pub render_setup_s: Option<f64>,
+    /// `Renderer::render` of it, landed (60 steps), image read back included (ms, median of 3).
+    pub render_ms: Option<f64>,
+    /// Whether start-up times had Mesa's shader cache to draw on.
+    pub shader_cache: String,
+    pub cases: Vec<CaseResult>,
+    pub scaling: Option<Scaling>,
+    pub targets: Vec<Target>,
+}
+
+fn median(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let m = s.len() / 2;
+    if s.len() % 2 == 1 {
+        s[m]
+    } else {
+        0.5 * (s[m - 1] + s[m])
+    }
+}
+
+/// The processor's model name (Linux), else "unknown".
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// The bytes `World::with_gpu` allocates for `scene` (mirrors its buffer
+/// sizes: two state buffers, props, vel0, the grid at its rounded hash size,
+/// contacts and counts, status, params slots and the joint lists).
+pub fn gpu_bytes(scene: &Scene) -> u64 {
+    let n = scene.bodies.len().max(1) as u64;
+    let radii: Vec<f32> = scene.bodies.iter().map(|b| b.bounding_radius()).collect();
+    let (large, grid) = world::plan_grid(&radii);
+    let size = |s: u64| s.max(16);
+    let hash = grid.hash_size as u64;
+    let state = std::mem::size_of::<BodyState>() as u64;
+    let contact = std::mem::size_of::<Contact>() as u64;
+    let joints = (scene.bodies.len() as u64 + 1) * 4 + 2 * scene.joints.len() as u64 * std::mem::size_of::<JointRef>() as u64;
+    2 * size(n * state)
+        + size(n * std::mem::size_of::<BodyProps>() as u64)
+        + size(n * std::mem::size_of::<Velocity>() as u64)
+        + size(4 * hash)
+        + size(4 * (hash + 1))
+        + size(4 * hash.div_ceil(SCAN_BLOCK as u64))
+        + size(4 * n)
+        + size(4 * large.len() as u64)
+        + size(n * MAX_CONTACTS as u64 * contact)
+        + size(4 * n)
+        + 16
+        + PARAMS_STRIDE * 64
+        + joints
+}
+
+fn mean_height(bodies: impl Iterator<Item = f32>) -> f64 {
+    let (sum, count) = bodies.fold((0.0f64, 0usize), |(s, c), y| (s + y as f64, c + 1));
+    if count == 0 {
+        0.0
+    } else {
+        sum / count as f64
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The memory-bound limit
+// ---------------------------------------------------------------------------
+
+const COPY_WGSL: &str = r#"
+struct BodyState { pos: vec4<f32>, prev_pos: vec4<f32>, rot: vec4<f32>, prev_rot: vec4<f32> }
+struct Count { n: u32 }
+@group(0) @binding(0) var<storage, read> src: array<BodyState>;
+@group(0) @binding(1) var<storage, read_write> dst: array<BodyState>;
+@group(0) @binding(2) var<uniform> count: Count;
+
+@compute @workgroup_size(64)
+fn copy_state(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i < count.n) {
+        dst[i] = src[i];
+    }
+}
+"#;
+
+/// A trivial kernel copying `n` body states (64 bytes each) from one buffer
+/// to another, one invocation per body in workgroups of 64 as the step's
+/// passes are: the memory-bound floor of the integration pass.
+pub struct CopyKernel {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    n: u32,
+    _buffers: Vec<wgpu::Buffer>,
+}
+
+impl CopyKernel {
+    pub fn new(gpu: &Gpu, n: usize) -> Result<CopyKernel, Error> {
+        let device = &gpu.device;
+        let bytes = (n.max(1) * std::mem::size_of::<BodyState>()) as u64;
+        if bytes > (gpu.limits.max_storage_buffer_binding_size as u64).min(gpu.limits.max_buffer_size) {
+            return Err(Error::Capacity(format!("copy kernel: {n} states do not fit one storage binding")));
+        }
+        let storage = |label: &str| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
+        let (src, dst) = (storage("copy/src"), storage("copy/dst"));
+        let count = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("copy/count"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue.write_buffer(&count, 0, bytemuck::cast_slice(&[n as u32, 0, 0, 0]));
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("copy_state"),
+            source: wgpu::ShaderSource::Wgsl(COPY_WGSL.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("copy_state"),
+            layout: None,
+            module: &module,
+            entry_point: Some("copy_state"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("copy_state"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: src.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: dst.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: count.as_entire_binding() },
+            ],
+        });
+        gpu.check()?;
+        Ok(CopyKernel { pipeline, bind_group, n: n as u32, _buffers: vec![src, dst, count] })
+    }
+
+    /// Bytes one pass moves (read and written).
+    pub fn bytes_per_pass(&self) -> u64 {
+        2 * self.n as u64 * std::mem::size_of::<BodyState>() as u64
+    }
+
+    /// Times `passes` passes (ms each), as `World::profile` times the step's:
+    /// GPU timestamps around each pass where the adapter has them, else each
+    /// pass submitted and waited for alone under the wall clock.
+    pub fn time(&self, gpu: &Gpu, passes: usize) -> Result<Vec<f64>, Error> {
+        // a query set holds at most 4096 queries
+        let mut out = Vec::with_capacity(passes.max(1));
+        while out.len() < passes.max(1) {
+            out.extend(self.time_some(gpu, (passes.max(1) - out.len()).min(1024))?);
+        }
+        Ok(out)
+    }
+
+    fn time_some(&self, gpu: &Gpu, passes: usize) -> Result<Vec<f64>, Error> {
+        let passes = passes.max(1);
+        let groups = self.n.div_ceil(WORKGROUP).max(1);
+        let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let encode = |enc: &mut wgpu::CommandEncoder, writes: Option<wgpu::ComputePassTimestampWrites<'_>>| {
+            let mut pass =
+                enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("copy_state"), timestamp_writes: writes });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        };
+        if timestamps {
+            let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("copy_state"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * passes as u32,
+            });
+            let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("copy_state/resolve"),
+                size: 16 * passes as u64,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            for k in 0..passes as u32 {
+                let writes = wgpu::ComputePassTimestampWrites {
+                    query_set: &set,
+                    beginning_of_pass_write_index: Some(2 * k),
+                    end_of_pass_write_index: Some(2 * k + 1),
+                };
+                encode(&mut enc, Some(writes));
+            }
+            enc.resolve_query_set(&set, 0..2 * passes as u32, &resolve, 0);
+            gpu.queue.submit([enc.finish()]);
+            let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&gpu.read_buffer(&resolve, 16 * passes as u64)?);
+            let period_ms = gpu.queue.get_timestamp_period() as f64 * 1e-6;
+            Ok((0..passes).map(|k| ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period_ms).collect())
+        } else {
+            let mut out = Vec::with_capacity(passes);
+            for _ in 0..passes {
+                gpu.wait()?;
+                let started = Instant::now();
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                encode(&mut enc, None);
+                gpu.queue.submit([enc.finish()]);
+                gpu.wait()?;
+                out.push(started.elapsed().as_secs_f64() * 1e3);
+            }
+            Ok(out)
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The rapier3d peer
+// ---------------------------------------------------------------------------
+
+/// The identical scene in rapier3d: same bodies (shapes, sizes, masses,
+/// poses, velocities), friction combined as our geometric mean and
+/// restitution as our max, the ground as a fixed half-space, the same dt,
+/// gravity and damping (our β per step as rapier's coefficient
+/// `-ln(1 - β) / dt`), ball joints as spherical impulse joints whose bodies
+/// do not collide (as ours do not), world-pinned ends on a fixed body at the
+/// origin. Bodies never sleep unless asked; CCD is off as rapier's default.
+#[cfg(feature = "rapier")]
+pub mod peer {
+    use rapier3d::na::Unit;
+    use rapier3d::prelude::*;
+
+    use crate::scene::{Scene, Shape};
+
+    /// The peer's name as reported.
+    pub const ENGINE: &str = "rapier3d 0.36";
+
+    /// Whether rapier3d was built with its rayon-parallel pipeline.
+    pub const PARALLEL: bool = cfg!(feature = "rapier-parallel");
+
+    pub struct RapierWorld {
+        pub world: PhysicsWorld,
+    }
+
+    impl RapierWorld {
+        pub fn new(scene: &Scene, sleeping: bool, iterations: Option<usize>) -> RapierWorld {
+            let s = &scene.settings;
+            let mut w = PhysicsWorld::default();
+            w.gravity = Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]);
+            w.integration_parameters.dt = s.dt;
+            if let Some(k) = iterations {
+                w.integration_parameters.num_solver_iterations = k.max(1);
+            }
+            let damping = |beta: f32| -((1.0 - beta as f64).ln() / s.dt as f64) as f32;
+            let material = |c: ColliderBuilder, friction: f32, restitution: f32| {
+                c.friction(friction)
+                    .friction_combine_rule(CoefficientCombineRule::GeometricMean)
+                    .restitution(restitution)
+                    .restitution_combine_rule(CoefficientCombineRule::Max)
+            };
+            if let Some(g) = &scene.ground {
+                let ground = ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Y))
+                    .translation(Vector::new(0.0, g.height, 0.0));
+                w.insert_collider(material(ground, s.friction, s.restitution), None);
+            }
+            let mut handles = Vec::with_capacity(scene.bodies.len());
+            for b in &scene.bodies {
+                let o = b.orientation;
+                let pose = Pose::from_parts(
+                    Vector::new(b.position[0], b.position[1], b.position[2]),
+                    Rotation::from_xyzw(o[0], o[1], o[2], o[3]).normalize(),
+                );
+                let body = if b.fixed { RigidBodyBuilder::fixed() } else { RigidBodyBuilder::dynamic() }
+                    .pose(pose)
+                    .linvel(Vector::new(b.linear_velocity[0], b.linear_velocity[1], b.linear_velocity[2]))
+                    .angvel(Vector::new(b.angular_velocity[0], b.angular_velocity[1], b.angular_velocity[2]))
+                    .linear_damping(damping(s.linear_damping))
+                    .angular_damping(damping(s.angular_damping))
+                    .can_sleep(sleeping);
+                let shape = match b.shape {
+                    Shape::Box { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
+                    Shape::Sphere { radius } => ColliderBuilder::ball(radius),
+                };
+                let collider = material(
+                    shape.mass(b.mass),
+                    b.friction.unwrap_or(s.friction),
+                    b.restitution.unwrap_or(s.restitution),
+                );
+                handles.push(w.insert(body, collider).0);
+            }
+            let mut anchor_body = None;
+            for j in &scene.joints {
+                let mut side = |k: usize| -> RigidBodyHandle {
+                    if j.bodies[k] >= 0 {
+                        handles[j.bodies[k] as usize]
+                    } else {
+                        *anchor_body.get_or_insert_with(|| w.insert_body(RigidBodyBuilder::fixed()))
+                    }
+                };
+                let (h1, h2) = (side(0), side(1));
+                let a = |k: usize| Vector::new(j.anchors[k][0], j.anchors[k][1], j.anchors[k][2]);
+                let joint = SphericalJointBuilder::new().local_anchor1(a(0)).local_anchor2(a(1)).contacts_enabled(false);
+                w.impulse_joints.insert(h1, h2, joint, true);
+            }
+            RapierWorld { world: w }
+        }
+
+        pub fn step(&mut self, steps: u64) {
+            for _ in 0..steps {
+                self.world.step();
+            }
+        }
+
+        pub fn num_solver_iterations(&self) -> usize {
+            self.world.integration_parameters.num_solver_iterations
+        }
+
+        /// Mean height of the dynamic bodies (m).
+        pub fn mean_height(&self) -> f64 {
+            super::mean_height(self.world.bodies.iter().filter(|(_, b)| b.is_dynamic()).map(|(_, b)| b.translation().y))
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Running
+// ---------------------------------------------------------------------------
+
+macro_rules! progress {
+    ($($t:tt)*) => {{ eprintln!($($t)*); }};
+}
+
+/// Runs the benchmark and prints the report; writes `--json` and `--csv`.
+pub fn run(opts: &Options) -> Result<Report, Error> {
+    let steps = opts.steps.unwrap_or(if opts.quick { QUICK_STEPS } else { DEFAULT_STEPS });
+    let reps = opts.reps.unwrap_or(if opts.quick { QUICK_REPS } else { DEFAULT_REPS });
+    let profile_steps = opts.profile_steps.unwrap_or(if opts.quick { 3 } else { PROFILE_STEPS });
+    let body_steps = opts.body_steps.unwrap_or(if opts.quick { QUICK_BODY_STEPS } else { DEFAULT_BODY_STEPS });
+    if steps == 0 {
+        return Err(Error::Input("--steps: must be at least 1".into()));
+    }
+    if reps == 0 {
+        return Err(Error::Input("--reps: must be at least 1".into()));
+    }
+    let specs: Vec<String> = if opts.cases.is_empty() {
+        if opts.quick { QUICK_CASES.iter().map(|s| s.to_string()).collect() } else { CASES.iter().map(|c| c.0.to_string()).collect() }
+    } else {
+        opts.cases.iter().flat_map(|s| s.split(',')).map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect()
+    };
+    let cases: Vec<Case> = specs.iter().map(|s| Case::parse(s)).collect::<Result<_, _>>()?;
+    // fail on unwritable outputs before the long run, not after it
+    for path in [&opts.json, &opts.csv].into_iter().flatten() {
+        std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+            .map_err(|source| Error::Io { path: path.display().to_string(), source })?;
+    }
+
+    let started = Instant::now();
+    let gpu = Arc::new(Gpu::new()?);
+    let gpu_open_s = started.elapsed().as_secs_f64();
+    let max = world::max_bodies(&gpu);
+    let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    progress!(
+        "bench: {} (up to {steps} steps, at most {body_steps} body-steps, x {reps} reps per case)",
+        gpu.describe()
+    );
+    let mesa_cache = std::env::var("MESA_SHADER_CACHE_DISABLE").map_or(false, |v| v == "true" || v == "1");
+
+    let settings = crate::Settings::default();
+    let (peer_name, iterations) = peer_description(opts, &settings);
+    let mut results = Vec::new();
+    for case in &cases {
+        let r = run_case(&gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
+        results.push(r);
+    }
+    // Rendering comes last: on lavapipe (Mesa 22.3) compute-pass timestamps
+    // taken after a render pass on the same device come out near zero, so a
+    // render before a profile would corrupt the per-stage table.
+    let render = if profile_steps > 0 { Some(render_cubes(&gpu)?) } else { None };
+    if let (Some((setup, ms)), Some(r)) = (render, results.iter_mut().find(|r| r.case == "cubes-1k")) {
+        r.render_setup_s = Some(setup);
+        r.render_ms = Some(ms);
+    }
+    let report = Report {
+        command: opts.command.clone(),
+        cpu: cpu_model(),
+        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        adapter: gpu.describe(),
+        gpu_timestamps: timestamps,
+        max_bodies: max,
+        max_storage_buffer_binding_size: gpu.limits.max_storage_buffer_binding_size as u64,
+        bytes_per_body: world::bytes_per_body(),
+        iterations,
+        peer: peer_name,
+        gpu_open_s,
+        render_setup_s: render.map(|r| r.0),
+        render_ms: render.map(|r| r.1),
+        shader_cache: if mesa_cache { "disabled (MESA_SHADER_CACHE_DISABLE)" } else { "Mesa's default (on-disk cache on)" }.into(),
+        scaling: scaling(&results),
+        targets: Vec::new(),
+        cases: results,
+    };
+    let report = Report { targets: targets(&report), ..report };
+    print!("{}", table(&report));
+    if let Some(path) = &opts.json {
+        let text = serde_json::to_string_pretty(&report).expect("the report serialises");
+        crate::output::write_file(path, &text)?;
+    }
+    if let Some(path) = &opts.csv {
+        crate::output::write_file(path, &csv(&report))?;
+    }
+    Ok(report)
+}
+
+/// Renders the 1000-cube scene after 60 steps at 640 x 480: (set-up s, ms per frame).
+fn render_cubes(gpu: &Arc<Gpu>) -> Result<(f64, f64), Error> {
+    let scene = case("cubes-1k").scene();
+    let mut world = World::with_gpu(gpu.clone(), &scene)?;
+    world.step(60)?;
+    gpu.wait()?;
+    let t = Instant::now();
+    let mut renderer = Renderer::new(gpu, &scene, 640, 480)?;
+    let setup = t.elapsed().as_secs_f64();
+    renderer.render(&world)?; // the first frame compiles the raster pipelines
+    let mut frames = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        renderer.render(&world)?;
+        frames.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    progress!("render: cubes-1k at 640x480: {:.1} ms/frame (set-up {setup:.2} s)", median(&frames));
+    Ok((setup, median(&frames)))
+}
+
+fn peer_description(opts: &Options, settings: &crate::Settings) -> (String, String) {
+    let ours = format!(
+        "ours: {} Jacobi iterations x {} substeps = {} relaxation sweeps per step (defaults; the chain scene uses 8 substeps), \
+         contacts found once per step",
+        settings.iterations,
+        settings.substeps,
+        settings.iterations * settings.substeps
+    );
+    #[cfg(feature = "rapier")]
+    {
+        let k = opts.rapier_iterations.unwrap_or_else(|| rapier3d::prelude::IntegrationParameters::default().num_solver_iterations);
+        let name = format!(
+            "{} ({}), sleeping {}, CCD off, num_solver_iterations = {k}{}",
+            peer::ENGINE,
+            if peer::PARALLEL { "rayon-parallel" } else { "single-threaded" },
+            if opts.rapier_sleeping { "on" } else { "off" },
+            if opts.rapier_iterations.is_some() { "" } else { " (its default)" },
+        );
+        let its = format!(
+            "{ours}; rapier: num_solver_iterations = {k} (TGS-soft substeps, each 1 PGS velocity iteration + 1 stabilisation \
+             iteration, Gauss-Seidel), contacts found once per step"
+        );
+        (if opts.no_peer { "none (--no-peer)".into() } else { name }, its)
+    }
+    #[cfg(not(feature = "rapier"))]
+    {
+        let _ = opts;
+        ("none (built without --features rapier)".into(), ours)
+    }
+}
+
+/// A case's result before anything is measured.
+fn blank(case: &Case, scene: &Scene, steps: u64, reps: usize) -> CaseResult {
+    let n = scene.bodies.len();
+    CaseResult {
+        case: case.name.clone(),
+        scene: case.scene.clone(),
+        bodies: n,
+        joints: scene.joints.len(),
+        skipped: None,
+        note: None,
+        steps,
+        reps,
+        startup_s: f64::NAN,
+        first_step_ms: f64::NAN,
+        setup_s: f64::NAN,
+        ms_per_step: Vec::new(),
+        median_ms_per_step: f64::NAN,
+        body_steps_per_s: f64::NAN,
+        gpu_bytes_estimate: world::bytes_per_body() * n as u64,
+        gpu_bytes: gpu_bytes(scene),
+        gpu_bytes_per_body: gpu_bytes(scene) as f64 / n.max(1) as f64,
+        stages: None,
+        readback_ms: f64::NAN,
+        render_setup_s: None,
+        render_ms: None,
+        integrate_ms_per_pass: None,
+        copy_ms_per_pass: None,
+        max_contacts: 0,
+        contacts_overflowed: false,
+        mean_height: f64::NAN,
+        peer: None,
+    }
+}
+
+fn run_case(
+    gpu: &Arc<Gpu>,
+    case: &Case,
+    (steps, body_steps): (u64, u64),
+    reps: usize,
+    profile_steps: u64,
+    max: u64,
+    opts: &Options,
+) -> Result<CaseResult, Error> {
+    let mut case = case.clone();
+    let mut note = None;
+    let mut scene = case.scene();
+    if scene.bodies.len() as u64 > max {
+        // ask the world, so the reason is the one `verlet run` gives
+        let why = match World::with_gpu(gpu.clone(), &scene) {
+            Err(e) => e.to_string(),
+            Ok(_) => format!("{} bodies exceed max_bodies = {max}", scene.bodies.len()),
+        };
+        progress!("{}: does not fit: {why}", case.name);
+        if case.scene != "cubes" || max == 0 {
+            return Ok(CaseResult { skipped: Some(why), ..blank(&case, &scene, steps, reps) });
+        }
+        let n = max as usize;
+        note = Some(format!("{} cubes do not fit ({why}); run at the adapter's maximum, {n}", scene.bodies.len()));
+        case.count = Some(n);
+        case.name = format!("cubes-max ({n})");
+        scene = case.scene();
+    }
+    let n = scene.bodies.len();
+    let steps = steps.min((body_steps / n.max(1) as u64).max(MIN_STEPS));
+    let profile_steps = profile_steps.min((body_steps / 10 / n.max(1) as u64).max(3));
+    let mut out = CaseResult { note, ..blank(&case, &scene, steps, reps) };
+
+    // 1. start-up, apart
+    let t = Instant::now();
+    let mut world = World::with_gpu(gpu.clone(), &scene)?;
+    gpu.wait()?;
+    let upload = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    world.step(1)?;
+    gpu.wait()?;
+    out.first_step_ms = t.elapsed().as_secs_f64() * 1e3;
+    out.startup_s = upload + out.first_step_ms * 1e-3;
+    drop(world);
+    progress!("{}: {n} bodies, start-up {:.2} s (first step {:.1} ms); {steps} steps per rep", case.name, out.startup_s, out.first_step_ms);
+
+    // 2. repetitions from the same initial state
+    let mut setups = Vec::new();
+    let mut last = None;
+    for r in 0..reps {
+        let t = Instant::now();
+        let mut world = World::with_gpu(gpu.clone(), &scene)?;
+        gpu.wait()?;
+        setups.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        world.step(steps)?;
+        gpu.wait()?;
+        let ms = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
+        out.ms_per_step.push(ms);
+        progress!("{}: rep {}/{reps}: {ms:.3} ms/step", case.name, r + 1);
+        last = Some(world);
+    }
+    let mut world = last.expect("reps >= 1");
+    out.setup_s = median(&setups);
+    out.median_ms_per_step = median(&out.ms_per_step);
+    out.body_steps_per_s = n as f64 / (out.median_ms_per_step * 1e-3);
+
+    // 3. the state, a readback, the stages, a render
+    let mut readbacks = Vec::new();
+    let mut bodies = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        bodies = world.read_state()?;
+        readbacks.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    out.readback_ms = median(&readbacks);
+    out.mean_height =
+        mean_height(bodies.iter().zip(&scene.bodies).filter(|(_, b)| !b.fixed).map(|(o, _)| o.position[1]));
+    let report = world.contact_report()?;
+    out.max_contacts = report.run_max;
+    out.contacts_overflowed = report.overflowed();
+    if profile_steps > 0 {
+        let times = world.profile(profile_steps)?;
+        let stages = Stages::from_times(&times, profile_steps);
+        out.integrate_ms_per_pass = Some(stages.integrate / scene.settings.substeps.max(1) as f64);
+        out.stages = Some(stages);
+        let copy = CopyKernel::new(gpu, n)?;
+        copy.time(gpu, 3)?; // compile and warm
+        out.copy_ms_per_pass = Some(median(&copy.time(gpu, 20)?));
+    }
+    drop(world);
+    progress!(
+        "{}: median {:.3} ms/step, {:.3e} body-steps/s, {:.0} B/body",
+        case.name,
+        out.median_ms_per_step,
+        out.body_steps_per_s,
+        out.gpu_bytes_per_body
+    );
+
+    // 5. the peer
+    out.peer = run_peer(&case, &scene, steps, reps, out.median_ms_per_step, opts);
+    Ok(out)
+}
+
+#[cfg(feature = "rapier")]
+fn run_peer(case: &Case, scene: &Scene, steps: u64, reps: usize, ours_ms: f64, opts: &Options) -> Option<PeerResult> {
+    if opts.no_peer || opts.peer_max_bodies.is_some_and(|m| scene.bodies.len() > m) {
+        return None;
+    }
+    let mut times = Vec::new();
+    let mut setups = Vec::new();
+    let mut last = None;
+    for r in 0..reps {
+        let t = Instant::now();
+        let mut w = peer::RapierWorld::new(scene, opts.rapier_sleeping, opts.rapier_iterations);
+        setups.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        w.step(steps);
+        let ms = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
+        progress!("{}: rapier rep {}/{reps}: {ms:.3} ms/step", case.name, r + 1);
+        times.push(ms);
+        last = Some(w);
+    }
+    let w = last?;
+    let m = median(&times);
+    Some(PeerResult {
+        engine: peer::ENGINE.into(),
+        threads: if peer::PARALLEL { "rayon".into() } else { "1".into() },
+        sleeping: opts.rapier_sleeping,
+        num_solver_iterations: w.num_solver_iterations(),
+        setup_s: median(&setups),
+        ms_per_step: times,
+        median_ms_per_step: m,
+        body_steps_per_s: scene.bodies.len() as f64 / (m * 1e-3),
+        speedup: m / ours_ms,
+        mean_height: w.mean_height(),
+    })
+}
+
+#[cfg(not(feature = "rapier"))]
+fn run_peer(_: &Case, _: &Scene, _: u64, _: usize, _: f64, _: &Options) -> Option<PeerResult> {
+    None
+}
+
+/// Fits the exponent over the cubes cases of 10 000 bodies and more.
+pub fn scaling(results: &[CaseResult]) -> Option<Scaling> {
+    let mut points: Vec<(usize, f64)> = results
+        .iter()
+        .filter(|r| r.scene == "cubes" && r.skipped.is_none() && r.bodies >= 10_000 && r.median_ms_per_step.is_finite())
+        .map(|r| (r.bodies, r.median_ms_per_step))
+        .collect();
+    points.sort_by_key(|p| p.0);
+    points.dedup_by_key(|p| p.0);
+    if points.len() < 2 {
+        return None;
+    }
+    let xs: Vec<f64> = points.iter().map(|p| (p.0 as f64).ln()).collect();
+    let ys: Vec<f64> = points.iter().map(|p| p.1.ln()).collect();
+    let k = xs.len() as f64;
+    let (mx, my) = (xs.iter().sum::<f64>() / k, ys.iter().sum::<f64>() / k);
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
+    let per: Vec<f64> = points.iter().map(|p| p.1 / p.0 as f64).collect();
+    let spread = per.iter().cloned().fold(f64::MIN, f64::max) / per.iter().cloned().fold(f64::MAX, f64::min);
+    Some(Scaling { points, exponent: sxy / sxx, spread })
+}
+
+fn targets(report: &Report) -> Vec<Target> {
+    let cubes = |n: usize| report.cases.iter().find(|r| r.scene == "cubes" && r.bodies == n && r.skipped.is_none());
+    let mut out = Vec::new();
+    let t10 = "10 000 cubes (300 steps): faster per step than rapier3d";
+    out.push(match cubes(10_000) {
+        Some(r) => match &r.peer {
+            Some(p) => Target {
+                target: t10.into(),
+                met: Some(r.median_ms_per_step < p.median_ms_per_step),
+                measured: format!(
+                    "{:.2} ms/step vs rapier {:.2} ms/step ({:.2}x) over {} steps",
+                    r.median_ms_per_step, p.median_ms_per_step, p.speedup, r.steps
+                ),
+            },
+            None => Target { target: t10.into(), met: None, measured: format!("{:.2} ms/step; no peer run", r.median_ms_per_step) },
+        },
+        None => Target { target: t10.into(), met: None, measured: "not run".into() },
+    });
+    let t100 = "100 000 cubes: >= 5x rapier3d's throughput and >= 2M body-steps/s";
+    out.push(match cubes(100_000) {
+        Some(r) => {
+            let fast = r.body_steps_per_s >= 2e6;
+            match &r.peer {
+                Some(p) => Target {
+                    target: t100.into(),
+                    met: Some(fast && p.speedup >= 5.0),
+                    measured: format!("{:.2}x rapier, {:.2}M body-steps/s", p.speedup, r.body_steps_per_s / 1e6),
+                },
+                None => Target {
+                    target: t100.into(),
+                    met: if fast { None } else { Some(false) },
+                    measured: format!("{:.2}M body-steps/s; no peer run", r.body_steps_per_s / 1e6),
+                },
+            }
+        }
+        None => Target { target: t100.into(), met: None, measured: "not run".into() },
+    });
+    let largest = report.cases.iter().filter(|r| r.scene == "cubes" && r.skipped.is_none()).max_by_key(|r| r.bodies);
+    let tint = "integrate pass within 2x of a memory-bound copy of the state";
+    out.push(match largest.and_then(|r| Some((r, r.integrate_ms_per_pass?, r.copy_ms_per_pass?))) {
+        Some((r, i, c)) => Target {
+            target: tint.into(),
+            met: Some(i <= 2.0 * c),
+            measured: format!("{}: integrate {:.3} ms/pass vs copy {:.3} ms/pass ({:.2}x)", r.case, i, c, i / c),
+        },
+        None => Target { target: tint.into(), met: None, measured: "not profiled".into() },
+    });
+    let tmem = "GPU memory <= 512 B/body (grid and contacts included)";
+    out.push(match largest {
+        Some(r) => Target {
+            target: tmem.into(),
+            met: Some(r.gpu_bytes_per_body <= 512.0),
+            measured: format!("{}: {:.0} B/body allocated ({} B/body by bytes_per_body)", r.case, r.gpu_bytes_per_body, report.bytes_per_body),
+        },
+        None => Target { target: tmem.into(), met: None, measured: "not run".into() },
+    });
+    let tscale = "10k to 1M: cost per body-step flat within 1.5x";
+    out.push(match &report.scaling {
+        Some(s) => Target {
+            target: tscale.into(),
+            met: Some(s.spread <= 1.5 && s.points.last().is_some_and(|p| p.0 >= 1_000_000)),
+            measured: format!(
+                "exponent {:.2} over {} to {} bodies, spread {:.2}x{}",
+                s.exponent,
+                s.points[0].0,
+                s.points.last().unwrap().0,
+                s.spread,
+                if s.points.last().unwrap().0 < 1_000_000 { " (1M not reached)" } else { "" }
+            ),
+        },
+        None => Target { target: tscale.into(), met: None, measured: "fewer than two cubes cases of >= 10k bodies".into() },
+    });
+    out
+}
+
+fn fmt_ms(v: f64) -> String {
+    if !v.is_finite() {
+        "-".into()
+    } else if v >= 100.0 {
+        format!("{v:.1}")
+    } else if v >= 1.0 {
+        format!("{v:.2}")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
+fn fmt_rate(v: f64) -> String {
+    if !v.is_finite() {
+        "-".into()
+    } else if v >= 1e6 {
+        format!("{:.2} M", v / 1e6)
+    } else {
+        format!("{:.0} k", v / 1e3)
+    }
+}
+
+/// The report as Markdown tables (readable as plain text too).
+pub fn table(r: &Report) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "\nmachine: {} ({} cores)", r.cpu, r.cores);
+    let _ = writeln!(s, "adapter: {}", r.adapter);
+    let _ = writeln!(
+        s,
+        "limits:  max_storage_buffer_binding_size {} B, max_bodies {}, bytes_per_body {} B; GPU opened in {:.2} s",
+        r.max_storage_buffer_binding_size, r.max_bodies, r.bytes_per_body, r.gpu_open_s
+    );
+    let _ = writeln!(s, "shader cache: {}", r.shader_cache);
+    let _ = writeln!(s, "peer:    {}", r.peer);
+    let _ = writeln!(s, "solver:  {}", r.iterations);
+    let _ = writeln!(s, "command: {}\n", r.command);
+    let _ = writeln!(
+        s,
+        "| case | bodies | steps x reps | start-up s | ms/step (median) | body-steps/s | GPU MiB | B/body | rapier ms/step | rapier body-steps/s | speed-up |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for c in &r.cases {
+        if let Some(why) = &c.skipped {
+            let _ = writeln!(s, "| {} | {} | - | - | does not fit | - | - | - | - | - | - |", c.case, c.bodies);
+            let _ = writeln!(s, "|  | ({why}) |||||||||");
+            continue;
+        }
+        let (pm, pr, sp) = match &c.peer {
+            Some(p) => (fmt_ms(p.median_ms_per_step), fmt_rate(p.body_steps_per_s), format!("{:.2}x", p.speedup)),
+            None => ("-".into(), "-".into(), "-".into()),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} x {} | {:.2} | {} | {} | {:.1} | {:.0} | {} | {} | {} |",
+            c.case,
+            c.bodies,
+            c.steps,
+            c.reps,
+            c.startup_s,
+            fmt_ms(c.median_ms_per_step),
+            fmt_rate(c.body_steps_per_s),
+            c.gpu_bytes as f64 / (1u64 << 20) as f64,
+            c.gpu_bytes_per_body,
+            pm,
+            pr,
+            sp
+        );
+    }
+    let source = r.cases.iter().find_map(|c| c.stages.as_ref().map(|st| st.source.clone()));
+    if let Some(source) = source {
+        let _ = writeln!(s, "\nper stage, ms per step ({source}; readback and render by wall clock):\n");
+        let _ = writeln!(
+            s,
+            "| case | broadphase | narrowphase | integrate | solve | restitution | sum of passes | wall ms/step | readback | render 640x480 | integrate/pass | copy/pass | integrate/copy |"
+        );
+        let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        for c in &r.cases {
+            let Some(st) = &c.stages else { continue };
+            let ratio = match (c.integrate_ms_per_pass, c.copy_ms_per_pass) {
+                (Some(i), Some(k)) if k > 0.0 => format!("{:.2}x", i / k),
+                _ => "-".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                c.case,
+                fmt_ms(st.broadphase),
+                fmt_ms(st.narrowphase),
+                fmt_ms(st.integrate),
+                fmt_ms(st.solve),
+                fmt_ms(st.restitution),
+                fmt_ms(st.total),
+                fmt_ms(c.median_ms_per_step),
+                fmt_ms(c.readback_ms),
+                c.render_ms.map_or("-".into(), fmt_ms),
+                c.integrate_ms_per_pass.map_or("-".into(), fmt_ms),
+                c.copy_ms_per_pass.map_or("-".into(), fmt_ms),
+                ratio
+            );
+        }
+    }
+    let _ = writeln!(s, "\nsanity (after the last repetition):\n");
+    let _ = writeln!(s, "| case | first step ms | set-up s (cached) | mean height m | rapier mean height m | max contacts/body | overflow |");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---|");
+    for c in r.cases.iter().filter(|c| c.skipped.is_none()) {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.2} | {:.3} | {} | {} | {} |",
+            c.case,
+            fmt_ms(c.first_step_ms),
+            c.setup_s,
+            c.mean_height,
+            c.peer.as_ref().map_or("-".into(), |p| format!("{:.3}", p.mean_height)),
+            c.max_contacts,
+            if c.contacts_overflowed { "yes" } else { "no" }
+        );
+    }
+    for c in &r.cases {
+        if let Some(n) = &c.note {
+            let _ = writeln!(s, "\nnote: {}: {n}", c.case);
+        }
+    }
+    if let (Some(setup), Some(ms)) = (r.render_setup_s, r.render_ms) {
+        let _ = writeln!(
+            s,
+            "\nrender: the 1000-cube scene, landed, at 640 x 480 (4x MSAA, shadow map, image read back): {} ms/frame; renderer set-up {setup:.2} s",
+            fmt_ms(ms)
+        );
+    }
+    if let Some(sc) = &r.scaling {
+        let pts: Vec<String> = sc.points.iter().map(|(n, ms)| format!("{n}: {:.1} ns/body-step", ms * 1e6 / *n as f64)).collect();
+        let _ = writeln!(
+            s,
+            "\nscaling: time per step ~ bodies^{:.2} (log-log least squares over {}); cost per body-step spread {:.2}x",
+            sc.exponent,
+            pts.join(", "),
+            sc.spread
+        );
+    }
+    let _ = writeln!(s, "\ntargets (issue 6):\n");
+    for t in &r.targets {
+        let mark = match t.met {
+            Some(true) => "met",
+            Some(false) => "MISSED",
+            None => "not measured",
+        };
+        let _ = writeln!(s, "- {}: **{mark}** — {}", t.target, t.measured);
+    }
+    s
+}
+
+/// One row per case.
+pub fn csv(r: &Report) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::from(
+        "case,scene,bodies,steps,reps,skipped,startup_s,first_step_ms,setup_s,median_ms_per_step,body_steps_per_s,\
+         gpu_bytes,gpu_bytes_per_body,stage_source,broadphase_ms,narrowphase_ms,integrate_ms,solve_ms,restitution_ms,\
+         readback_ms,render_ms,integrate_ms_per_pass,copy_ms_per_pass,peer,peer_median_ms_per_step,peer_body_steps_per_s,speedup,adapter\n",
+    );
+    let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x}"));
+    let quote = |t: &str| format!("\"{}\"", t.replace('"', "\"\""));
+    for c in &r.cases {
+        let st = c.stages.as_ref();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            quote(&c.case),
+            c.scene,
+            c.bodies,
+            c.steps,
+            c.reps,
+            quote(c.skipped.as_deref().unwrap_or("")),
+            c.startup_s,
+            c.first_step_ms,
+            c.setup_s,
+            c.median_ms_per_step,
+            c.body_steps_per_s,
+            c.gpu_bytes,
+            c.gpu_bytes_per_body,
+            st.map_or(String::new(), |x| x.source.clone()),
+            opt(st.map(|x| x.broadphase)),
+            opt(st.map(|x| x.narrowphase)),
+            opt(st.map(|x| x.integrate)),
+            opt(st.map(|x| x.solve)),
+            opt(st.map(|x| x.restitution)),
+            c.readback_ms,
+            opt(c.render_ms),
+            opt(c.integrate_ms_per_pass),
+            opt(c.copy_ms_per_pass),
+            quote(&c.peer.as_ref().map_or(String::new(), |p| format!("{} threads={}", p.engine, p.threads))),
+            opt(c.peer.as_ref().map(|p| p.median_ms_per_step)),
+            opt(c.peer.as_ref().map(|p| p.body_steps_per_s)),
+            opt(c.peer.as_ref().map(|p| p.speedup)),
+            quote(&r.adapter)
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn named_cases_parse_and_build() {
+        for (name, _, count) in CASES {
+            let c = Case::parse(name).unwrap();
+            assert_eq!(c.name, *name);
+            if *name != "cubes-1m" && *name != "cubes-100k" {
+                assert_eq!(c.scene().bodies.len(), count.map_or(0, |n| if c.scene == "pyramid" { n * (n + 1) / 2 } else { n }));
+            }
+        }
+        let c = Case::parse("cubes:2000").unwrap();
+        assert_eq!((c.name.as_str(), c.count), ("cubes-2000", Some(2000)));
+        assert!(Case::parse("nope").is_err());
+        assert!(Case::parse("cubes:0").is_err());
+    }
+
+    #[test]
+    fn exponent_of_a_power_law() {
+        let mk = |n: usize, ms: f64| CaseResult {
+            scene: "cubes".into(),
+            bodies: n,
+            median_ms_per_step: ms,
+            ..result_stub()
+        };
+        let rs = vec![mk(10_000, 2.0), mk(100_000, 20.0), mk(1_000_000, 200.0), mk(1_000, 99.0)];
+        let s = scaling(&rs).unwrap();
+        assert!((s.exponent - 1.0).abs() < 1e-9, "{}", s.exponent);
+        assert!((s.spread - 1.0).abs() < 1e-9);
+        assert_eq!(s.points.len(), 3);
+    }
+
+    #[test]
+    fn memory_covers_the_estimate_and_the_median() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        let scene = scenes::cubes(1000, SEED);
+        // the exact sizes round the hash table up, so never below the per-body estimate less the grid's share
+        assert!(gpu_bytes(&scene) >= (world::bytes_per_body() - 20) * 1000);
+    }
+
+    fn result_stub() -> CaseResult {
+        let c = case("pyramid");
+        blank(&c, &c.scene(), 1, 1)
+    }
+}
