@@ -9,6 +9,8 @@ use crate::gpu::{types::*, Gpu};
 use crate::scene::{Body, Scene, Settings, Shape};
 use crate::step::{Over, Stage, StepPipelines, STORAGE_BUFFERS};
 use crate::Error;
+
+pub mod input;
 pub mod snapshot;
 
 /// Steps encoded into one submission; each gets its own `Params` slot.
@@ -127,6 +129,8 @@ pub struct World {
     time: f64,
     /// Length of the last (sub)step taken (s): what `pos - prev_pos` spans.
     dt_prev: f32,
+    /// The user-input kernels (`input.rs`), built on the first input.
+    input: Option<input::InputGpu>,
 }
 
 impl World {
@@ -247,6 +251,7 @@ impl World {
             step: 0,
             time: 0.0,
             dt_prev: substep_dt,
+            input: None,
         })
     }
 

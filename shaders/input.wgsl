@@ -1,0 +1,202 @@
+// User input between steps (src/world/input.rs): impulses, poses,
+// velocities and fixed/dynamic switches of single bodies (entry point
+// `apply_inputs`, one thread per run of ops on one body) and radial
+// explosions (entry point `explode`, one thread per body). Assembled after
+// common.wgsl and bindings.wgsl, but it binds only state_out (the current
+// state buffer, rewritten in place) and what it declares below; and Verlet's velocity is
+// implicit, so a change of velocity is a change of the previous pose:
+// v = (pos - prev_pos) / h and the turn rot * prev_rot^* = exp(w h), where h
+// is the substep that produced them (input.gravity.w).
+
+struct InputHeader {
+    gravity: vec4<f32>, // xyz = settings.gravity (m/s^2); w = h, the last substep (s)
+    centre: vec4<f32>,  // explode: xyz = centre (m); w = strength, an impulse (N s)
+    reach: vec4<f32>,   // explode: x = radius (m), y = falloff exponent
+    counts: vec4<u32>,  // x = body_count, y = ops in input_ops
+}
+
+// One input to one body. 64 bytes. Ops come sorted by body (in call order
+// within a body); the first op of each body's run holds the run's length.
+struct InputOp {
+    body: u32,
+    kind: u32, // INPUT_*
+    run: u32,  // ops of this body starting here (0: not the first of its run)
+    _pad0: u32,
+    a: vec4<f32>,
+    b: vec4<f32>,
+    c: vec4<f32>,
+}
+
+// a.xyz = impulse (N s); a.w = 0 at the centre, 1 at world point b.xyz,
+// 2 at body-frame point b.xyz
+const INPUT_IMPULSE: u32 = 0u;
+// a.xyz = position, b = unit orientation; velocities are kept
+const INPUT_POSE: u32 = 1u;
+// a.xyz = linear (m/s), b.xyz = angular (rad/s, world frame)
+const INPUT_VELOCITY: u32 = 2u;
+// a.x = 1: make fixed; a.x = 0: make dynamic with mass a.y (kg), or with the
+// mass kept when it was made fixed (material.z, an inverse mass) if a.y = 0
+const INPUT_FIXED: u32 = 3u;
+
+// and bindings.wgsl's state_out (binding 3): the current state buffer
+@group(0) @binding(16) var<uniform> input: InputHeader;
+@group(0) @binding(17) var<storage, read> input_ops: array<InputOp>;
+// the props buffer, writable (switching fixed/dynamic writes it)
+@group(0) @binding(18) var<storage, read_write> props_rw: array<BodyProps>;
+
+// World angular velocity the state implies over the substep h.
+fn implied_spin(s: BodyState, h: f32) -> vec3<f32> {
+    return quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))) / h;
+}
+
+// The previous orientation that makes the next step turn by w h.
+fn prev_rot_for_spin(rot: vec4<f32>, w: vec3<f32>, h: f32) -> vec4<f32> {
+    return normalize(quat_mul(quat_conj(quat_from_rotvec(w * h)), rot));
+}
+
+// Body-frame principal inverse inertia of the body's shape with mass m.
+fn shape_inv_inertia(p: BodyProps, m: f32) -> vec3<f32> {
+    let h = p.half_extents.xyz;
+    if (p.kind.x == SHAPE_SPHERE) {
+        return vec3<f32>(1.0 / (0.4 * m * h.x * h.x));
+    }
+    let q = h * h;
+    return vec3<f32>(3.0 / (m * (q.y + q.z)), 3.0 / (m * (q.x + q.z)), 3.0 / (m * (q.x + q.y)));
+}
+
+fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> BodyState {
+    var s = s_in;
+    let p = *p_in;
+    let h = input.gravity.w;
+    let fixed = is_fixed(p);
+    switch op.kind {
+        case INPUT_IMPULSE: {
+            if (fixed) {
+                return s;
+            }
+            let j = op.a.xyz;
+            s.prev_pos = vec4<f32>(s.prev_pos.xyz - j * (p.inv_inertia.w * h), s.prev_pos.w);
+            var r = vec3<f32>(0.0);
+            if (op.a.w == 1.0) {
+                r = op.b.xyz - s.pos.xyz;
+            } else if (op.a.w == 2.0) {
+                r = quat_rotate(s.rot, op.b.xyz);
+            }
+            let dw = inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, j));
+            if (any(dw != vec3<f32>(0.0))) {
+                s.prev_rot = prev_rot_for_spin(s.rot, implied_spin(s, h) + dw, h);
+            }
+        }
+        case INPUT_POSE: {
+            let moved = s.pos.xyz - s.prev_pos.xyz;
+            let turn = quat_mul(s.rot, quat_conj(s.prev_rot));
+            let q = op.b;
+            s.pos = vec4<f32>(op.a.xyz, s.pos.w);
+            s.rot = q;
+            if (fixed) {
+                s.prev_pos = s.pos;
+                s.prev_rot = q;
+            } else {
+                s.prev_pos = vec4<f32>(op.a.xyz - moved, s.prev_pos.w);
+                s.prev_rot = normalize(quat_mul(quat_conj(turn), q));
+            }
+        }
+        case INPUT_VELOCITY: {
+            if (fixed) {
+                return s;
+            }
+            // as the scene loader does: the next steps follow x + v t + g t^2 / 2
+            let v = op.a.xyz;
+            s.prev_pos = vec4<f32>(s.pos.xyz - v * h + 0.5 * input.gravity.xyz * (h * h), s.prev_pos.w);
+            s.prev_rot = prev_rot_for_spin(s.rot, op.b.xyz, h);
+        }
+        case INPUT_FIXED: {
+            var np = p;
+            if (op.a.x == 1.0) {
+                if (!fixed) {
+                    np.material.z = p.inv_inertia.w; // kept for a later switch back
+                }
+                np.kind.y = p.kind.y | FLAG_FIXED;
+                np.inv_inertia = vec4<f32>(0.0);
+                s.prev_pos = s.pos;
+                s.prev_rot = s.rot;
+            } else if (fixed) {
+                var m = op.a.y;
+                if (m <= 0.0) {
+                    m = 1.0 / np.material.z;
+                }
+                np.kind.y = p.kind.y & ~FLAG_FIXED;
+                np.inv_inertia = vec4<f32>(shape_inv_inertia(p, m), 1.0 / m);
+                np.material.z = 0.0;
+                // at rest, as the scene loader starts a body: the next steps
+                // follow x + g t^2 / 2
+                s.prev_pos = vec4<f32>(s.pos.xyz + 0.5 * input.gravity.xyz * (h * h), s.pos.w);
+                s.prev_rot = s.rot;
+            }
+            *p_in = np;
+        }
+        default: {}
+    }
+    return s;
+}
+
+@compute @workgroup_size(WORKGROUP)
+fn apply_inputs(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= input.counts.y) {
+        return;
+    }
+    let first = input_ops[k];
+    if (first.run == 0u || first.body >= input.counts.x) {
+        return;
+    }
+    let i = first.body;
+    var s = state_out[i];
+    var p = props_rw[i];
+    let p0 = p;
+    for (var j = k; j < k + first.run; j = j + 1u) {
+        s = apply_op(input_ops[j], s, &p);
+    }
+    state_out[i] = s;
+    if (any(p.kind != p0.kind) || any(p.inv_inertia != p0.inv_inertia) || any(p.material != p0.material)) {
+        props_rw[i] = p;
+    }
+}
+
+// A radial impulse of input.centre.w (N s) on every dynamic body whose centre
+// lies within input.reach.x of input.centre.xyz, scaled by (1 - d / radius)
+// ^ falloff, along the direction from the centre to the body's centre (up
+// for a body at the centre). It changes the velocity only, by J / m; bodies
+// outside the radius are not written at all.
+@compute @workgroup_size(WORKGROUP)
+fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= input.counts.x) {
+        return;
+    }
+    let p = props_rw[i];
+    if (is_fixed(p)) {
+        return;
+    }
+    var s = state_out[i];
+    let d = s.pos.xyz - input.centre.xyz;
+    let dist = length(d);
+    let radius = input.reach.x;
+    if (!(dist < radius)) {
+        return;
+    }
+    var dir = vec3<f32>(0.0, 1.0, 0.0);
+    if (dist > 0.0) {
+        dir = d / dist;
+    }
+    let base = 1.0 - dist / radius;
+    var scale = 1.0; // pow(x, 0) is undefined at x = 0 in WGSL
+    if (input.reach.y == 1.0) {
+        scale = base;
+    } else if (input.reach.y != 0.0) {
+        scale = pow(base, input.reach.y);
+    }
+    let dv = dir * (input.centre.w * scale * p.inv_inertia.w);
+    s.prev_pos = vec4<f32>(s.prev_pos.xyz - dv * input.gravity.w, s.prev_pos.w);
+    state_out[i] = s;
+}

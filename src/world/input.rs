@@ -1,0 +1,443 @@
+//! User input between steps (issue 8): impulses and forces at a point,
+//! poses, velocities, fixed/dynamic switches and radial explosions.
+//!
+//! Nothing is read back. Every call validates its arguments on the host
+//! (a bad body index or a non-finite number is an [`Error::Input`] naming
+//! the argument), then writes a small list of ops and dispatches a kernel of
+//! `shaders/input.wgsl` that rewrites the affected bodies' slots of the
+//! current state buffer in place. The queue orders it after the steps
+//! already submitted and before the next one, so the host never waits.
+//!
+//! Why a kernel and not `queue.write_buffer` of a 64-byte slot: the
+//! velocity of a Verlet body is implicit in its previous pose, and an
+//! impulse, or a new pose that keeps the body's velocity, must start from
+//! the current state, which only the GPU holds. A kernel reads it where it
+//! is; the alternative, a 64-byte readback per call, would stall the host
+//! until every submitted step has run. A batch of inputs ([`World::apply_inputs`])
+//! is one dispatch: ops are sorted by body (in call order within a body) and
+//! one thread applies each body's run of ops in order, so any number of
+//! inputs to the same body compose without races.
+//!
+//! Velocity changes rewrite the previous pose: with h the substep that
+//! produced the current pose, v = (pos - prev_pos) / h and the world-frame
+//! turn rot * prev_rot^* = exp(w h), which is what the next `integrate`
+//! repeats.
+//!
+//! The kernel's resources (two pipelines, one bind group per state buffer, a
+//! uniform header and a growing op list) are built on first use and kept in
+//! `World::input`.
+
+use bytemuck::{Pod, Zeroable};
+
+use super::World;
+use crate::gpu::shaders::{BINDINGS, COMMON};
+use crate::gpu::types::WORKGROUP;
+use crate::Error;
+
+/// `shaders/input.wgsl`, the kernels of this module.
+pub const INPUT: &str = include_str!("../../shaders/input.wgsl");
+
+/// Entry points of the input module.
+pub const ENTRY_POINTS: [&str; 2] = ["apply_inputs", "explode"];
+
+/// The assembled WGSL module: common.wgsl, bindings.wgsl (only for the
+/// declarations common.wgsl's helpers name; none of them is bound), input.wgsl.
+pub fn source() -> String {
+    [COMMON, BINDINGS, INPUT].concat()
+}
+
+/// Where an impulse or force acts on a body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Point {
+    /// At the centre of mass: no change of spin.
+    Centre,
+    /// At a point in world coordinates (m).
+    World([f32; 3]),
+    /// At a point in the body's own frame, relative to its centre (m).
+    Local([f32; 3]),
+}
+
+/// One input to one body, for [`World::apply_inputs`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BodyInput {
+    /// Changes the velocity by J / m and the spin by I^-1 (r x J), with I
+    /// the world-frame inertia at the current orientation and r from the
+    /// centre of mass to the point. No effect on a fixed body.
+    Impulse { body: usize, impulse: [f32; 3], point: Point },
+    /// Moves the body to this pose, keeping its velocities (world frame).
+    /// The orientation is normalised.
+    Pose { body: usize, position: [f32; 3], orientation: [f32; 4] },
+    /// Sets the velocities (world frame); from here the body follows
+    /// x + v t + g t^2 / 2, as a body loaded with these velocities does. No
+    /// effect on a fixed body.
+    Velocity { body: usize, linear: [f32; 3], angular: [f32; 3] },
+    /// `fixed: true` makes the body immovable (infinite mass, at rest);
+    /// `false` makes a fixed body dynamic again, at rest, with `mass` (kg)
+    /// and the inertia of a solid of its shape, or with `mass: None` the mass
+    /// it had when it was made fixed. A body loaded as fixed has no mass on
+    /// record: it needs `Some(mass)` (with `None` it gets 1 kg).
+    Fixed { body: usize, fixed: bool, mass: Option<f32> },
+}
+
+impl BodyInput {
+    fn body(&self) -> usize {
+        match *self {
+            BodyInput::Impulse { body, .. }
+            | BodyInput::Pose { body, .. }
+            | BodyInput::Velocity { body, .. }
+            | BodyInput::Fixed { body, .. } => body,
+        }
+    }
+}
+
+/// Host twin of `InputHeader` in shaders/input.wgsl (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct InputHeader {
+    pub gravity: [f32; 4],
+    pub centre: [f32; 4],
+    pub reach: [f32; 4],
+    pub counts: [u32; 4],
+}
+
+/// Host twin of `InputOp` in shaders/input.wgsl (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct InputOp {
+    pub body: u32,
+    pub kind: u32,
+    pub run: u32,
+    pub _pad0: u32,
+    pub a: [f32; 4],
+    pub b: [f32; 4],
+    pub c: [f32; 4],
+}
+
+const INPUT_IMPULSE: u32 = 0;
+const INPUT_POSE: u32 = 1;
+const INPUT_VELOCITY: u32 = 2;
+const INPUT_FIXED: u32 = 3;
+
+/// Bindings of shaders/input.wgsl (group 0).
+const BIND_STATE: u32 = 3;
+const BIND_HEADER: u32 = 16;
+const BIND_OPS: u32 = 17;
+const BIND_PROPS: u32 = 18;
+
+/// The input kernels' pipelines and buffers, built on a world's first input.
+pub(super) struct InputGpu {
+    layout: wgpu::BindGroupLayout,
+    apply: wgpu::ComputePipeline,
+    explode: wgpu::ComputePipeline,
+    header: wgpu::Buffer,
+    ops: wgpu::Buffer,
+    /// Ops `ops` holds.
+    capacity: usize,
+    /// `bind_groups[k]` rewrites `states[k]`.
+    bind_groups: [wgpu::BindGroup; 2],
+}
+
+fn check_finite(name: &str, values: &[f32]) -> Result<(), Error> {
+    for (k, v) in values.iter().enumerate() {
+        if !v.is_finite() {
+            let at = if values.len() > 1 { format!("{name}[{k}]") } else { name.to_string() };
+            return Err(Error::Input(format!("{at}: must be a finite number, got {v}")));
+        }
+    }
+    Ok(())
+}
+
+impl World {
+    /// Applies an impulse (N s) at `point` (world coordinates; `None`: the
+    /// centre of mass) before the next step: the velocity changes by J / m,
+    /// the spin by I^-1 (r x J) with I in the world frame. No effect on a
+    /// fixed body.
+    pub fn apply_impulse(&mut self, body: usize, impulse: [f32; 3], point: Option<[f32; 3]>) -> Result<(), Error> {
+        let point = point.map_or(Point::Centre, Point::World);
+        self.input_ops(&[BodyInput::Impulse { body, impulse, point }], "")
+    }
+
+    /// [`World::apply_impulse`] at a point in the body's own frame
+    /// (relative to its centre of mass).
+    pub fn apply_impulse_local(&mut self, body: usize, impulse: [f32; 3], local_point: [f32; 3]) -> Result<(), Error> {
+        self.input_ops(&[BodyInput::Impulse { body, impulse, point: Point::Local(local_point) }], "")
+    }
+
+    /// A force (N) acting for `duration` seconds, applied as the impulse
+    /// F * duration before the next step (to push over one step, give the
+    /// step's dt).
+    pub fn apply_force(&mut self, body: usize, force: [f32; 3], point: Option<[f32; 3]>, duration: f32) -> Result<(), Error> {
+        check_finite("force", &force)?;
+        if !(duration.is_finite() && duration >= 0.0) {
+            return Err(Error::Input(format!("duration: must be a finite number of seconds >= 0, got {duration}")));
+        }
+        self.apply_impulse(body, force.map(|f| f * duration), point)
+    }
+
+    /// Moves a body to a pose (orientation `[x, y, z, w]`, normalised here),
+    /// keeping its velocities.
+    pub fn set_pose(&mut self, body: usize, position: [f32; 3], orientation: [f32; 4]) -> Result<(), Error> {
+        self.input_ops(&[BodyInput::Pose { body, position, orientation }], "")
+    }
+
+    /// Sets a body's velocities (m/s and rad/s, world frame): from here it
+    /// moves as a body loaded with them does. No effect on a fixed body.
+    pub fn set_velocity(&mut self, body: usize, linear: [f32; 3], angular: [f32; 3]) -> Result<(), Error> {
+        self.input_ops(&[BodyInput::Velocity { body, linear, angular }], "")
+    }
+
+    /// Makes a body immovable (`true`, at rest where it is) or dynamic again
+    /// (`false`, at rest, with the mass it had when it was made fixed); see
+    /// [`BodyInput::Fixed`] for a body loaded as fixed.
+    pub fn set_fixed(&mut self, body: usize, fixed: bool) -> Result<(), Error> {
+        self.input_ops(&[BodyInput::Fixed { body, fixed, mass: None }], "")
+    }
+
+    /// Makes a body dynamic, at rest, with `mass` (kg) and the inertia of a
+    /// solid of its shape.
+    pub fn set_dynamic(&mut self, body: usize, mass: f32) -> Result<(), Error> {
+        self.input_ops(&[BodyInput::Fixed { body, fixed: false, mass: Some(mass) }], "")
+    }
+
+    /// Applies a batch of inputs in one dispatch, in order within each body.
+    /// Nothing is applied if any input is bad; the error names it
+    /// (`inputs[2].impulse[1]: ...`).
+    pub fn apply_inputs(&mut self, inputs: &[BodyInput]) -> Result<(), Error> {
+        self.input_ops(inputs, "inputs")
+    }
+
+    /// A radial explosion: every dynamic body whose centre of mass lies
+    /// strictly within `radius` (m) of `centre` gets the impulse `strength`
+    /// (N s) through its centre, along the direction from `centre` to it
+    /// (up for a body exactly at the centre), scaled by
+    /// `(1 - d / radius) ^ falloff`: its velocity changes by that over its
+    /// mass, its spin not at all. `falloff` 0 is uniform, 1 linear, 2
+    /// quadratic. A negative strength pulls inward. Bodies outside the radius
+    /// are not touched.
+    pub fn explode(&mut self, centre: [f32; 3], strength: f32, radius: f32, falloff: f32) -> Result<(), Error> {
+        check_finite("centre", &centre)?;
+        check_finite("strength", &[strength])?;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(Error::Input(format!("radius: must be a positive finite number of metres, got {radius}")));
+        }
+        if !(falloff.is_finite() && falloff >= 0.0) {
+            return Err(Error::Input(format!("falloff: must be a finite exponent >= 0, got {falloff}")));
+        }
+        let header = InputHeader {
+            centre: [centre[0], centre[1], centre[2], strength],
+            reach: [radius, falloff, 0.0, 0.0],
+            ..self.input_header(0)
+        };
+        self.dispatch_input(&header, &[], true)
+    }
+
+    fn input_header(&self, ops: usize) -> InputHeader {
+        let g = self.settings.gravity;
+        InputHeader {
+            gravity: [g[0], g[1], g[2], self.dt_prev],
+            counts: [self.body_count, ops as u32, 0, 0],
+            ..Default::default()
+        }
+    }
+
+    /// Validates `inputs` (naming bad ones after `list`, or plainly when it
+    /// is empty), sorts them into runs per body and dispatches them.
+    fn input_ops(&mut self, inputs: &[BodyInput], list: &str) -> Result<(), Error> {
+        let mut ops = Vec::with_capacity(inputs.len());
+        for (k, input) in inputs.iter().enumerate() {
+            let at = |name: &str| if list.is_empty() { name.to_string() } else { format!("{list}[{k}].{name}") };
+            let body = input.body();
+            if body >= self.body_count as usize {
+                return Err(Error::Input(format!(
+                    "{}: no body {body} (the world has {} bodies)",
+                    at("body"),
+                    self.body_count
+                )));
+            }
+            let mut op = InputOp { body: body as u32, ..Default::default() };
+            match *input {
+                BodyInput::Impulse { impulse, point, .. } => {
+                    check_finite(&at("impulse"), &impulse)?;
+                    op.kind = INPUT_IMPULSE;
+                    op.a = [impulse[0], impulse[1], impulse[2], 0.0];
+                    let (mode, p) = match point {
+                        Point::Centre => (0.0, [0.0; 3]),
+                        Point::World(p) => (1.0, p),
+                        Point::Local(p) => (2.0, p),
+                    };
+                    check_finite(&at("point"), &p)?;
+                    op.a[3] = mode;
+                    op.b = [p[0], p[1], p[2], 0.0];
+                }
+                BodyInput::Pose { position, orientation, .. } => {
+                    check_finite(&at("position"), &position)?;
+                    check_finite(&at("orientation"), &orientation)?;
+                    let q = orientation.map(|v| v as f64);
+                    let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    if !(norm > 0.0 && norm.is_finite()) {
+                        return Err(Error::Input(format!("{}: must be a non-zero quaternion", at("orientation"))));
+                    }
+                    op.kind = INPUT_POSE;
+                    op.a = [position[0], position[1], position[2], 0.0];
+                    op.b = q.map(|v| (v / norm) as f32);
+                }
+                BodyInput::Velocity { linear, angular, .. } => {
+                    check_finite(&at("linear"), &linear)?;
+                    check_finite(&at("angular"), &angular)?;
+                    op.kind = INPUT_VELOCITY;
+                    op.a = [linear[0], linear[1], linear[2], 0.0];
+                    op.b = [angular[0], angular[1], angular[2], 0.0];
+                }
+                BodyInput::Fixed { fixed, mass, .. } => {
+                    if let Some(m) = mass {
+                        if !(m.is_finite() && m > 0.0) {
+                            return Err(Error::Input(format!("{}: must be a positive finite number of kg, got {m}", at("mass"))));
+                        }
+                    }
+                    op.kind = INPUT_FIXED;
+                    op.a = [fixed as u32 as f32, mass.unwrap_or(0.0), 0.0, 0.0];
+                }
+            }
+            ops.push(op);
+        }
+        if ops.is_empty() {
+            return Ok(());
+        }
+        // runs per body, in call order within each (the sort is stable)
+        ops.sort_by_key(|op| op.body);
+        let mut start = 0;
+        while start < ops.len() {
+            let end = start + ops[start..].iter().take_while(|op| op.body == ops[start].body).count();
+            ops[start].run = (end - start) as u32;
+            start = end;
+        }
+        let header = self.input_header(ops.len());
+        self.dispatch_input(&header, &ops, false)
+    }
+
+    fn dispatch_input(&mut self, header: &InputHeader, ops: &[InputOp], explode: bool) -> Result<(), Error> {
+        if self.body_count == 0 {
+            return Ok(());
+        }
+        self.ensure_input_gpu(ops.len());
+        let gpu = self.gpu.clone();
+        let input = self.input.as_ref().expect("built above");
+        gpu.queue.write_buffer(&input.header, 0, bytemuck::bytes_of(header));
+        if !ops.is_empty() {
+            gpu.queue.write_buffer(&input.ops, 0, bytemuck::cast_slice(ops));
+        }
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("input") });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(if explode { "explode" } else { "apply_inputs" }),
+                timestamp_writes: None,
+            });
+            let threads = if explode { self.body_count as usize } else { ops.len() };
+            pass.set_pipeline(if explode { &input.explode } else { &input.apply });
+            pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
+            pass.dispatch_workgroups((threads as u32).div_ceil(WORKGROUP).max(1), 1, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check()?;
+        Ok(())
+    }
+
+    /// Builds the input kernels on first use, and grows the op list to hold
+    /// `ops` (rebuilding the bind groups).
+    fn ensure_input_gpu(&mut self, ops: usize) {
+        let device = &self.gpu.device;
+        let op_size = std::mem::size_of::<InputOp>();
+        let ops_buffer = |capacity: usize| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("input/ops"),
+                size: (capacity * op_size) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        // the props buffer is the first of WorldData::_others (see World::with_gpu)
+        let props = &self.data._others[0];
+        debug_assert_eq!(props.size(), (self.body_count.max(1) as u64 * 64).max(64));
+        let states = &self.data.states;
+        let bind_groups = |layout: &wgpu::BindGroupLayout, header: &wgpu::Buffer, list: &wgpu::Buffer| {
+            [0, 1].map(|k| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(if k == 0 { "input A" } else { "input B" }),
+                    layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: BIND_STATE, resource: states[k].as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: BIND_HEADER, resource: header.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: BIND_OPS, resource: list.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: BIND_PROPS, resource: props.as_entire_binding() },
+                    ],
+                })
+            })
+        };
+        match &mut self.input {
+            Some(input) => {
+                if input.capacity < ops {
+                    let capacity = ops.next_power_of_two();
+                    input.ops = ops_buffer(capacity);
+                    input.capacity = capacity;
+                    input.bind_groups = bind_groups(&input.layout, &input.header, &input.ops);
+                }
+            }
+            None => {
+                let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+                    binding,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+                    count: None,
+                };
+                let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("input"),
+                    entries: &[
+                        entry(BIND_STATE, storage(false)),
+                        entry(BIND_HEADER, wgpu::BufferBindingType::Uniform),
+                        entry(BIND_OPS, storage(true)),
+                        entry(BIND_PROPS, storage(false)),
+                    ],
+                });
+                let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("input"),
+                    bind_group_layouts: &[Some(&layout)],
+                    immediate_size: 0,
+                });
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("input"),
+                    source: wgpu::ShaderSource::Wgsl(source().into()),
+                });
+                let pipeline = |entry: &str| {
+                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(entry),
+                        layout: Some(&pipeline_layout),
+                        module: &module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                };
+                let header = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("input/header"),
+                    size: std::mem::size_of::<InputHeader>() as u64,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let capacity = ops.next_power_of_two().max(64);
+                let list = ops_buffer(capacity);
+                let groups = bind_groups(&layout, &header, &list);
+                self.input = Some(InputGpu {
+                    apply: pipeline(ENTRY_POINTS[0]),
+                    explode: pipeline(ENTRY_POINTS[1]),
+                    layout,
+                    header,
+                    ops: list,
+                    capacity,
+                    bind_groups: groups,
+                });
+            }
+        }
+    }
+
+}
