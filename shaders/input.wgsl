@@ -1,7 +1,8 @@
 // User input between steps (src/world/input.rs): impulses, poses,
 // velocities and fixed/dynamic switches of single bodies (entry point
 // `apply_inputs`, one thread per run of ops on one body) and radial
-// explosions (entry point `explode`, one thread per body). Assembled after
+// explosions and wind (entry points `explode` and `wind`, one thread per
+// body). Assembled after
 // common.wgsl and bindings.wgsl, but it binds only state_out (the current
 // state buffer, rewritten in place) and what it declares below; and Verlet's velocity is
 // implicit, so a change of velocity is a change of the previous pose:
@@ -11,7 +12,8 @@
 struct InputHeader {
     gravity: vec4<f32>, // xyz = settings.gravity (m/s^2); w = h, the last substep (s)
     centre: vec4<f32>,  // explode: xyz = centre (m); w = strength, an impulse (N s)
-    reach: vec4<f32>,   // explode: x = radius (m), y = falloff exponent
+                        // wind: xyz = wind velocity (m/s); w = air density * drag coefficient / 2
+    reach: vec4<f32>,   // explode: x = radius (m), y = falloff exponent; wind: x = duration (s)
     counts: vec4<u32>,  // x = body_count, y = ops in input_ops
 }
 
@@ -198,5 +200,43 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let dv = dir * (input.centre.w * scale * p.inv_inertia.w);
     s.prev_pos = vec4<f32>(s.prev_pos.xyz - dv * input.gravity.w, s.prev_pos.w);
+    state_out[i] = s;
+}
+
+// Area (m^2) of the body's shape seen along the unit world direction u.
+fn projected_area(p: BodyProps, rot: vec4<f32>, u: vec3<f32>) -> f32 {
+    let h = p.half_extents.xyz;
+    if (p.kind.x == SHAPE_SPHERE) {
+        return 3.14159265 * h.x * h.x;
+    }
+    let l = abs(quat_rotate(quat_conj(rot), u));
+    return 4.0 * (h.y * h.z * l.x + h.x * h.z * l.y + h.x * h.y * l.z);
+}
+
+// Quadratic drag of a uniform wind over input.reach.x seconds: the velocity
+// relative to the wind, u, decays as du/dt = -k |u| u with k = rho Cd A / 2m,
+// whose exact solution over t is u / (1 + k |u| t): never past the wind.
+@compute @workgroup_size(WORKGROUP)
+fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= input.counts.x) {
+        return;
+    }
+    let p = props_rw[i];
+    if (is_fixed(p)) {
+        return;
+    }
+    var s = state_out[i];
+    let h = input.gravity.w;
+    let v = (s.pos.xyz - s.prev_pos.xyz) / h;
+    let rel = input.centre.xyz - v; // wind relative to the body
+    let speed = length(rel);
+    if (speed == 0.0) {
+        return;
+    }
+    let k = input.centre.w * projected_area(p, s.rot, rel / speed) * p.inv_inertia.w;
+    let left = rel / (1.0 + k * speed * input.reach.x);
+    let dv = rel - left;
+    s.prev_pos = vec4<f32>(s.prev_pos.xyz - dv * h, s.prev_pos.w);
     state_out[i] = s;
 }

@@ -364,3 +364,64 @@ fn many_inputs_grow_the_op_list() {
     }
     let _ = Vec3::ZERO;
 }
+
+#[test]
+fn wind_drags_bodies_towards_its_velocity_by_their_area() {
+    use verlet::world::input::Wind;
+    let mut ball = sphere_body(0.5, [0.0, 0.0, 0.0]);
+    ball.mass = 1.0;
+    let mut cube = box_body([0.5; 3], [0.0, 0.0, 5.0]); // lanes across the wind
+    cube.mass = 50.0;
+    let mut turned = cube.clone();
+    turned.position = [0.0, 0.0, 10.0];
+    turned.orientation = Quat::from_rotation_y(std::f32::consts::FRAC_PI_4).to_array();
+    let mut wall = box_body([0.5; 3], [0.0, 0.0, 15.0]);
+    wall.fixed = true;
+    let sc = scene(free_settings(), vec![ball.clone(), cube.clone(), turned, wall]);
+    let Some(mut w) = world(&sc) else { return };
+    let wind = Wind { velocity: [10.0, 0.0, 0.0], drag: 0.47, ..Wind::default() };
+    let dt = sc.settings.dt;
+    let raw = w.read_raw().unwrap();
+    w.apply_wind(&wind, dt).unwrap();
+    w.step(1).unwrap();
+    let s = w.read_state().unwrap();
+    // the ball: exact solution of du/dt = -k u^2 over dt
+    let k = 0.5 * 1.225 * 0.47 * std::f64::consts::PI * 0.25 / 1.0;
+    let want = 10.0 - 10.0 / (1.0 + k * 10.0 * dt as f64);
+    let err = (s[0].linear_velocity[0] as f64 - want).abs() / want;
+    eprintln!("wind on a 1 kg ball: dv {:.5} m/s, want {want:.5} (error {err:.2e})", s[0].linear_velocity[0]);
+    assert!(err < 0.01, "ball: {:?}, want {want}", s[0].linear_velocity);
+    // a cube turned 45 degrees shows sqrt(2) times the area
+    let ratio = s[2].linear_velocity[0] / s[1].linear_velocity[0];
+    assert!((ratio - 2f32.sqrt()).abs() < 0.01, "area ratio {ratio}");
+    assert_eq!(w.read_raw().unwrap()[3], raw[3], "the wind moved a fixed body");
+    // blown for long, the ball nears the wind's speed and never passes it
+    let mut fastest = 0.0f32;
+    for _ in 0..300 {
+        w.apply_wind(&wind, dt).unwrap();
+        w.step(1).unwrap();
+        fastest = fastest.max(w.read_state().unwrap()[0].linear_velocity[0]);
+    }
+    let v = w.read_state().unwrap()[0].linear_velocity[0];
+    assert!(fastest <= 10.0 + 1e-3 && v > 9.0, "ball at {v} m/s (fastest {fastest}) in a 10 m/s wind");
+}
+
+#[test]
+fn gusts_stay_within_their_strength_and_bad_wind_is_refused() {
+    use verlet::world::input::Wind;
+    let wind = Wind { velocity: [0.0, 0.0, 8.0], gust: 0.5, gust_period: 3.0, ..Wind::default() };
+    let speeds: Vec<f32> = (0..600).map(|k| wind.at(k as f64 * 0.01)[2]).collect();
+    let (lo, hi) = speeds.iter().fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    assert!(lo >= 4.0 - 1e-4 && hi <= 12.0 + 1e-4 && hi - lo > 4.0, "gusts span {lo}..{hi} m/s");
+    let sc = scene(free_settings(), vec![sphere_body(0.5, [0.0; 3])]);
+    let Some(mut w) = world(&sc) else { return };
+    for (bad, name) in [
+        (Wind { drag: -1.0, ..wind }, "wind.drag"),
+        (Wind { gust_period: 0.0, ..wind }, "wind.gust_period"),
+        (Wind { velocity: [f32::NAN, 0.0, 0.0], ..wind }, "wind.velocity[0]"),
+    ] {
+        let msg = input_error(w.apply_wind(&bad, 0.1));
+        assert!(msg.starts_with(&format!("{name}:")), "{msg}");
+    }
+    assert!(input_error(w.apply_wind(&wind, f32::NAN)).starts_with("duration:"));
+}

@@ -38,7 +38,12 @@ use crate::Error;
 pub const INPUT: &str = include_str!("../../shaders/input.wgsl");
 
 /// Entry points of the input module.
-pub const ENTRY_POINTS: [&str; 2] = ["apply_inputs", "explode"];
+pub const ENTRY_POINTS: [&str; 3] = ["apply_inputs", "explode", "wind"];
+
+/// Indices into `ENTRY_POINTS` and `InputGpu::pipelines`.
+const APPLY: usize = 0;
+const EXPLODE: usize = 1;
+const WIND: usize = 2;
 
 /// The assembled WGSL module: common.wgsl, bindings.wgsl (only for the
 /// declarations common.wgsl's helpers name; none of them is bound), input.wgsl.
@@ -90,6 +95,65 @@ impl BodyInput {
     }
 }
 
+/// A uniform wind with optional gusts, for [`World::apply_wind`]: quadratic
+/// drag F = rho Cd A |u| u / 2 on every dynamic body, with u the wind's
+/// velocity relative to the body's and A the body's area seen along u (a
+/// box's projection, a sphere's disc), through the centre of mass (no
+/// torque).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wind {
+    /// Mean wind velocity (m/s, world frame).
+    pub velocity: [f32; 3],
+    /// Air density (kg/m^3); 1.225 at sea level.
+    pub air_density: f32,
+    /// Drag coefficient; 1.05 for a cube face on, 0.47 for a sphere.
+    pub drag: f32,
+    /// Gust strength: the wind is `velocity * (1 + gust * s(t))`, where
+    /// s(t) in [-1, 1] is a fixed sum of two incommensurate sines of
+    /// period `gust_period` and `gust_period / 2.71`. 0: steady.
+    pub gust: f32,
+    /// Seconds (> 0).
+    pub gust_period: f32,
+}
+
+impl Default for Wind {
+    fn default() -> Wind {
+        Wind { velocity: [0.0; 3], air_density: 1.225, drag: 1.0, gust: 0.0, gust_period: 4.0 }
+    }
+}
+
+impl Wind {
+    /// A steady wind of this velocity (m/s).
+    pub fn steady(velocity: [f32; 3]) -> Wind {
+        Wind { velocity, ..Wind::default() }
+    }
+
+    /// The gust profile s(t), in [-1, 1].
+    pub fn gust_profile(&self, t: f64) -> f64 {
+        let phase = std::f64::consts::TAU * t / self.gust_period as f64;
+        0.6 * phase.sin() + 0.4 * (2.71 * phase + 1.3).sin()
+    }
+
+    /// The wind velocity at time `t` (s).
+    pub fn at(&self, t: f64) -> [f32; 3] {
+        let scale = 1.0 + self.gust as f64 * self.gust_profile(t);
+        self.velocity.map(|v| (v as f64 * scale) as f32)
+    }
+
+    fn validate(&self) -> Result<(), Error> {
+        check_finite("wind.velocity", &self.velocity)?;
+        for (name, v) in [("wind.air_density", self.air_density), ("wind.drag", self.drag), ("wind.gust", self.gust)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::Input(format!("{name}: must be a finite number >= 0, got {v}")));
+            }
+        }
+        if !(self.gust_period.is_finite() && self.gust_period > 0.0) {
+            return Err(Error::Input(format!("wind.gust_period: must be a positive finite number of seconds, got {}", self.gust_period)));
+        }
+        Ok(())
+    }
+}
+
 /// Host twin of `InputHeader` in shaders/input.wgsl (64 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -127,8 +191,8 @@ const BIND_PROPS: u32 = 18;
 /// The input kernels' pipelines and buffers, built on a world's first input.
 pub(super) struct InputGpu {
     layout: wgpu::BindGroupLayout,
-    apply: wgpu::ComputePipeline,
-    explode: wgpu::ComputePipeline,
+    /// One per entry point, in the order of `ENTRY_POINTS`.
+    pipelines: [wgpu::ComputePipeline; 3],
     header: wgpu::Buffer,
     ops: wgpu::Buffer,
     /// Ops `ops` holds.
@@ -228,7 +292,27 @@ impl World {
             reach: [radius, falloff, 0.0, 0.0],
             ..self.input_header(0)
         };
-        self.dispatch_input(&header, &[], true)
+        self.dispatch_input(&header, &[], EXPLODE)
+    }
+
+    /// Blows `wind` on every dynamic body for `duration` seconds, as an
+    /// impulse before the next step: call it before each step with the
+    /// step's dt (the wind is taken at the world's current time, gusts
+    /// included). The drag is integrated implicitly enough never to push a
+    /// body past the wind's own velocity. This is the between-steps form; a
+    /// wind that acts within every substep needs `integrate` to add it.
+    pub fn apply_wind(&mut self, wind: &Wind, duration: f32) -> Result<(), Error> {
+        wind.validate()?;
+        if !(duration.is_finite() && duration >= 0.0) {
+            return Err(Error::Input(format!("duration: must be a finite number of seconds >= 0, got {duration}")));
+        }
+        let u = wind.at(self.time);
+        let header = InputHeader {
+            centre: [u[0], u[1], u[2], 0.5 * wind.air_density * wind.drag],
+            reach: [duration, 0.0, 0.0, 0.0],
+            ..self.input_header(0)
+        };
+        self.dispatch_input(&header, &[], WIND)
     }
 
     fn input_header(&self, ops: usize) -> InputHeader {
@@ -312,10 +396,10 @@ impl World {
             start = end;
         }
         let header = self.input_header(ops.len());
-        self.dispatch_input(&header, &ops, false)
+        self.dispatch_input(&header, &ops, APPLY)
     }
 
-    fn dispatch_input(&mut self, header: &InputHeader, ops: &[InputOp], explode: bool) -> Result<(), Error> {
+    fn dispatch_input(&mut self, header: &InputHeader, ops: &[InputOp], kernel: usize) -> Result<(), Error> {
         if self.body_count == 0 {
             return Ok(());
         }
@@ -329,11 +413,11 @@ impl World {
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("input") });
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(if explode { "explode" } else { "apply_inputs" }),
+                label: Some(ENTRY_POINTS[kernel]),
                 timestamp_writes: None,
             });
-            let threads = if explode { self.body_count as usize } else { ops.len() };
-            pass.set_pipeline(if explode { &input.explode } else { &input.apply });
+            let threads = if kernel == APPLY { ops.len() } else { self.body_count as usize };
+            pass.set_pipeline(&input.pipelines[kernel]);
             pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
             pass.dispatch_workgroups((threads as u32).div_ceil(WORKGROUP).max(1), 1, 1);
         }
@@ -428,8 +512,7 @@ impl World {
                 let list = ops_buffer(capacity);
                 let groups = bind_groups(&layout, &header, &list);
                 self.input = Some(InputGpu {
-                    apply: pipeline(ENTRY_POINTS[0]),
-                    explode: pipeline(ENTRY_POINTS[1]),
+                    pipelines: ENTRY_POINTS.map(pipeline),
                     layout,
                     header,
                     ops: list,
