@@ -425,3 +425,59 @@ fn gusts_stay_within_their_strength_and_bad_wind_is_refused() {
     }
     assert!(input_error(w.apply_wind(&wind, f32::NAN)).starts_with("duration:"));
 }
+
+#[test]
+fn inputs_queued_back_to_back_all_apply_in_order() {
+    let b = sphere_body(0.2, [0.0; 3]);
+    let sc = scene(free_settings(), vec![b.clone(), sphere_body(0.2, [2.0, 0.0, 0.0])]);
+    let Some(mut w) = world(&sc) else { return };
+    // no read in between: each call's op list and header reach the GPU before its dispatch
+    w.apply_impulse(0, [b.mass, 0.0, 0.0], None).unwrap();
+    w.apply_impulse(1, [0.0, b.mass, 0.0], None).unwrap();
+    w.set_velocity(0, [0.0, 0.0, 3.0], [0.0; 3]).unwrap();
+    w.apply_impulse(0, [b.mass, 0.0, 0.0], None).unwrap();
+    w.explode([2.0, -1.0, 0.0], b.mass, 2.0, 0.0).unwrap(); // body 1 is 1 m above it
+    w.step(1).unwrap();
+    let s = w.read_state().unwrap();
+    let close = |a: [f32; 3], b: [f32; 3]| (d3(a) - d3(b)).length() < 1e-3;
+    assert!(close(s[0].linear_velocity, [1.0, 0.0, 3.0]), "body 0: {:?}", s[0].linear_velocity);
+    assert!(close(s[1].linear_velocity, [0.0, 2.0, 0.0]), "body 1: {:?}", s[1].linear_velocity);
+}
+
+#[test]
+fn a_kinematic_paddle_moved_by_set_pose_pushes_boxes_without_passing_through() {
+    // a fixed body moved every step by set_pose is a kinematic body: it is
+    // static within each step, so the solve pushes what it reaches out of it
+    let mut paddle = box_body([0.1, 0.5, 1.0], [-1.0, 0.5, 0.0]);
+    paddle.fixed = true;
+    let mut bodies = vec![paddle];
+    for k in 0..3 {
+        bodies.push(box_body([0.25; 3], [0.0, 0.25, -0.6 + 0.6 * k as f32]));
+    }
+    let sc = Scene { ground: Some(verlet::Ground { height: 0.0 }), ..scene(Settings::default(), bodies) };
+    let Some(mut w) = world(&sc) else { return };
+    w.step(30).unwrap(); // settle
+    let dt = sc.settings.dt as f64;
+    let speed = 2.0;
+    let mut deepest = 0.0f64;
+    for n in 1..=90 {
+        let x = -1.0 + speed * dt * n as f64;
+        w.set_pose(0, [x as f32, 0.5, 0.0], [0.0, 0.0, 0.0, 1.0]).unwrap();
+        w.step(1).unwrap();
+        let s = w.read_state().unwrap();
+        let face = x + 0.1;
+        for k in 1..4 {
+            // how far a box's back face is behind the paddle's front face
+            let back = s[k].position[0] as f64 - 0.25;
+            deepest = deepest.max(face - back);
+            assert!(s[k].position[0] as f64 > x, "step {n}: box {k} at {:?} passed the paddle at {x}", s[k].position);
+        }
+    }
+    let s = w.read_state().unwrap();
+    let x = -1.0 + speed * dt * 90.0;
+    eprintln!("paddle at 2 m/s: deepest overlap {:.1} mm; boxes end at x = {:.3} {:.3} {:.3}, paddle front at {:.3}", deepest * 1e3, s[1].position[0], s[2].position[0], s[3].position[0], x + 0.1);
+    assert!(deepest < 0.03, "the paddle sank {deepest} m into a box");
+    for k in 1..4 {
+        assert!(s[k].position[0] as f64 >= x + 0.1 + 0.25 - 0.03, "box {k} left behind at {:?}", s[k].position);
+    }
+}

@@ -239,7 +239,11 @@ impl World {
     }
 
     /// Moves a body to a pose (orientation `[x, y, z, w]`, normalised here),
-    /// keeping its velocities.
+    /// keeping its velocities. Called before every step on a fixed body, it
+    /// drives that body along a path as a kinematic one (a paddle, a door):
+    /// the body is static within each step and the solve pushes whatever it
+    /// reaches out of it; it carries no velocity of its own into friction
+    /// and restitution.
     pub fn set_pose(&mut self, body: usize, position: [f32; 3], orientation: [f32; 4]) -> Result<(), Error> {
         self.input_ops(&[BodyInput::Pose { body, position, orientation }], "")
     }
