@@ -4,7 +4,7 @@
 mod common;
 
 use common::{quat, v3, world};
-use glam::{DQuat, DVec3, Quat, Vec3};
+use glam::{DQuat, DVec3, Quat};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::world::input::{BodyInput, Point};
 use verlet::{Body, Error, Scene, Settings, World};
@@ -305,7 +305,8 @@ fn bad_arguments_are_input_errors_naming_the_argument() {
     let sc = scene(free_settings(), vec![sphere_body(0.5, [0.0; 3])]);
     let Some(mut w) = world(&sc) else { return };
     let raw = w.read_raw().unwrap();
-    let cases: Vec<(Box<dyn Fn(&mut World) -> Result<(), Error>>, &str)> = vec![
+    type Call = Box<dyn Fn(&mut World) -> Result<(), Error>>;
+    let cases: Vec<(Call, &str)> = vec![
         (Box::new(|w| w.apply_impulse(1, [1.0; 3], None)), "body"),
         (Box::new(|w| w.apply_impulse(0, [1.0, f32::NAN, 0.0], None)), "impulse[1]"),
         (Box::new(|w| w.apply_impulse(0, [1.0; 3], Some([0.0, 0.0, f32::INFINITY]))), "point[2]"),
@@ -362,7 +363,6 @@ fn many_inputs_grow_the_op_list() {
         assert!((s[k].linear_velocity[1] - want).abs() < 1e-3, "body {k}: {:?}", s[k].linear_velocity);
         assert!(s[k].linear_velocity[0].abs() < 1e-4, "body {k}: {:?}", s[k].linear_velocity);
     }
-    let _ = Vec3::ZERO;
 }
 
 #[test]
