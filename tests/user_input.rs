@@ -71,7 +71,11 @@ fn impulse_at_an_offset_changes_spin_by_inverse_inertia_of_r_cross_j() {
     b.orientation = q0.as_quat().to_array();
     let mut far = b.clone();
     far.position[0] += 10.0;
-    let sc = scene(free_settings(), vec![b.clone(), far]);
+    let mut spinning = b.clone();
+    spinning.position[0] -= 10.0;
+    spinning.angular_velocity = [1.5, -0.5, 2.0];
+    spinning.linear_velocity = [0.0, 1.0, 0.0];
+    let sc = scene(free_settings(), vec![b.clone(), far, spinning]);
     let Some(mut w) = world(&sc) else { return };
     // the second body far away, hit at the same body-frame point
     let x0 = d3(b.position);
@@ -81,15 +85,24 @@ fn impulse_at_an_offset_changes_spin_by_inverse_inertia_of_r_cross_j() {
     w.apply_impulse(0, j.as_vec3().to_array(), Some((x0 + r).as_vec3().to_array())).unwrap();
     let local = (q0.conjugate() * r).as_vec3().to_array();
     w.apply_impulse_local(1, j.as_vec3().to_array(), local).unwrap();
+    // a spinning body, hit where that body-frame point has turned to
+    w.step(7).unwrap();
+    let before_spinning = w.read_state().unwrap()[2];
+    let q2 = quat(before_spinning.orientation).as_dquat();
+    let r2 = q2 * (q0.conjugate() * r);
+    w.apply_impulse(2, j.as_vec3().to_array(), Some((d3(before_spinning.position) + r2).as_vec3().to_array())).unwrap();
     w.step(1).unwrap();
+    let mut before = before;
+    before[2] = before_spinning;
     let after = w.read_state().unwrap();
-    let want_w = spin_change(&b, q0, r, j);
     let want_v = j / b.mass as f64;
-    for k in 0..2 {
+    for k in 0..3 {
+        let want_w = if k == 2 { spin_change(&b, q2, r2, j) } else { spin_change(&b, q0, r, j) };
         let dw = d3(after[k].angular_velocity) - d3(before[k].angular_velocity);
         let dv = d3(after[k].linear_velocity) - d3(before[k].linear_velocity);
         let (ew, ev) = (rel_err(dw, want_w), rel_err(dv, want_v));
-        eprintln!("impulse at offset ({}): |dw| {:.4} rad/s error {:.2e}; dv error {:.2e}", ["world point", "local point"][k], want_w.length(), ew, ev);
+        let what = ["world point", "local point", "world point, spinning body"][k];
+        eprintln!("impulse at offset ({what}): |dw| {:.4} rad/s error {ew:.2e}; dv error {ev:.2e}", want_w.length());
         assert!(ew < 0.02, "body {k}: spin change {dw:?}, want {want_w:?} ({:.3}% off)", ew * 100.0);
         assert!(ev < 0.01, "body {k}: velocity change {dv:?}, want {want_v:?}");
     }

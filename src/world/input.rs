@@ -249,7 +249,10 @@ impl World {
     }
 
     /// Sets a body's velocities (m/s and rad/s, world frame): from here it
-    /// moves as a body loaded with them does. No effect on a fixed body.
+    /// moves as a body loaded with them does, x + v t + g t^2 / 2 (so under
+    /// gravity `read_state` before the next step, which reports the
+    /// velocity over the last substep h, shows v - g h / 2). No effect on a
+    /// fixed body.
     pub fn set_velocity(&mut self, body: usize, linear: [f32; 3], angular: [f32; 3]) -> Result<(), Error> {
         self.input_ops(&[BodyInput::Velocity { body, linear, angular }], "")
     }
