@@ -12,6 +12,18 @@ struct Snap {
     dtheta: vec3<f32>,
 }
 
+// The translations one partner's points ask for, kept apart until the
+// partner's last point so they can be scaled together (see `flush`).
+struct Manifold {
+    normal_dx: vec3<f32>,   // summed translation of the normal snaps
+    normal_inv_w: f32,      // sum over those points of 1 / (w_self + w_partner)
+    friction_dx: vec3<f32>, // summed translation of the static-friction snaps
+    friction_inv_w: f32,
+    pair_w: f32,            // inverse masses of the two bodies, summed
+    dtheta: vec3<f32>,      // summed rotation of the points' snaps
+    points: u32,            // points that snapped
+}
+
 // Add a push of lambda along dir at offset r: translation along dir, rotation
 // about r x dir, both weighted by the body's inverse mass and inertia.
 fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>, lambda: f32) {
@@ -25,7 +37,7 @@ fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>
 // apart since their previous poses by less than mu times the normal push
 // summed over this substep, the slide is undone; a larger slide is left to
 // dynamic friction in the restitution pass. Returns the push (m).
-fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
+fn add_contact(acc: ptr<function, Snap>, m: ptr<function, Manifold>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
     let o = partner_point(c);
     let n = c.normal;
     let r = quat_rotate(s.rot, c.local_self);
@@ -42,7 +54,10 @@ fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact)
     // from other contacts in later iterations are resisted too
     var push = 0.0;
     if (depth > 0.0) {
-        add_push(acc, p, s.rot, r, n, depth / (effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n)));
+        let w = effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n);
+        (*m).dtheta = (*m).dtheta + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * (depth / w);
+        (*m).normal_dx = (*m).normal_dx + n * (p.inv_inertia.w * depth / w);
+        (*m).normal_inv_w = (*m).normal_inv_w + 1.0 / w;
         push = depth * params.relaxation;
     } else if (c.pushed <= 0.0 || depth < -CONTACT_SLOP) {
         return 0.0;
@@ -52,9 +67,29 @@ fn add_contact(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, c: Contact)
     let slide = length(slip_t);
     if (slide > 1e-9 && slide <= combined_friction(p, c) * (c.pushed + push)) {
         let t = slip_t / slide;
-        add_push(acc, p, s.rot, r, -t, slide / (effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t)));
+        let w = effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t);
+        (*m).dtheta = (*m).dtheta - inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, t)) * (slide / w);
+        (*m).friction_dx = (*m).friction_dx - t * (p.inv_inertia.w * slide / w);
+        (*m).friction_inv_w = (*m).friction_inv_w + 1.0 / w;
     }
     return push;
+}
+
+// Adds one partner's translations to the body's. Each point's snap moves the
+// body as if that point were alone; when several points of one face all ask
+// for the same depth d, their sum is d x (pair_w x the sum of 1/w), which
+// is d for points at the corners of a cube but four times d for points near
+// the middle of a large face (a box resting across two others): that
+// overshoot made piles vibrate and walk apart. The sum is scaled down to what
+// moving the two bodies apart without turning asks for, never up.
+fn flush(acc: ptr<function, Snap>, m: ptr<function, Manifold>) -> u32 {
+    let touched = u32((*m).points > 0u);
+    let n_scale = min(1.0, 1.0 / max((*m).pair_w * (*m).normal_inv_w, 1e-30));
+    let f_scale = min(1.0, 1.0 / max((*m).pair_w * (*m).friction_inv_w, 1e-30));
+    (*acc).dx = (*acc).dx + (*m).normal_dx * n_scale + (*m).friction_dx * f_scale;
+    (*acc).dtheta = (*acc).dtheta + (*m).dtheta / f32(max((*m).points, 1u));
+    *m = Manifold(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
+    return touched;
 }
 
 // One end of a ball joint: snap this body's share of the gap between the two
@@ -98,24 +133,38 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let first = i * MAX_CONTACTS;
     let count = contact_count[i];
     var touching = 0u;
+    // a partner's points are listed together (the narrowphase writes one
+    // manifold per pair)
+    var m = Manifold(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
+    var partner = GROUND;
     for (var k = first; k < first + count; k = k + 1u) {
-        let before = acc;
-        let push = add_contact(&acc, s, p, contacts[k]);
-        contacts[k].pushed = contacts[k].pushed + push;
-        if (any(acc.dx != before.dx) || any(acc.dtheta != before.dtheta)) {
-            touching = touching + 1u;
+        let c = contacts[k];
+        if (c.partner != partner) {
+            touching = touching + flush(&acc, &m);
+            partner = c.partner;
+        }
+        m.pair_w = p.inv_inertia.w;
+        if (c.partner != GROUND) {
+            m.pair_w = m.pair_w + props[c.partner].inv_inertia.w;
+        }
+        let count_before = m.normal_inv_w + m.friction_inv_w;
+        let push = add_contact(&acc, &m, s, p, c);
+        contacts[k].pushed = c.pushed + push;
+        if (m.normal_inv_w + m.friction_inv_w != count_before) {
+            m.points = m.points + 1u;
         }
     }
+    touching = touching + flush(&acc, &m);
     for (var k = joint_start[i]; k < joint_start[i + 1u]; k = k + 1u) {
         if (add_joint(&acc, s, p, joint_refs[k])) {
             touching = touching + 1u;
         }
     }
-    // Each contact's snap turns the body as if it were the only one; summed
-    // over several contacts the turns overshoot (four corners correcting a
-    // twist turn it back about twice too far), so the rotation is split
-    // among the active contacts (mass splitting, for the inertia only: the
-    // translations of a face's points already add up to the face's push).
+    // Each snap turns the body as if it were the only one; summed they
+    // overshoot (four corners correcting a twist turn it back about twice too
+    // far), so a partner's points share one turn (their mean, in `flush`) and
+    // the partners' turns are averaged too (mass splitting, for the inertia
+    // only: translations are scaled per partner in `flush`).
     let split = 1.0 / f32(max(touching, 1u));
     s.pos = vec4<f32>(s.pos.xyz + acc.dx * params.relaxation, 0.0);
     s.rot = quat_add_rotation(s.rot, acc.dtheta * (params.relaxation * split));
