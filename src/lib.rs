@@ -23,6 +23,7 @@ pub mod render;
 pub mod scene;
 pub mod scenes;
 pub mod step;
+pub mod track;
 pub mod world;
 
 pub use scene::{Body, Ground, Joint, Scene, SceneError, Settings, Shape};
@@ -35,6 +36,9 @@ pub enum Error {
     Scene(#[from] scene::SceneError),
     #[error("{0}")]
     Gpu(#[from] gpu::GpuError),
+    /// A scripted input track (`--input`) that did not load whole.
+    #[error("{0}")]
+    Track(#[from] track::TrackError),
     /// The scene does not fit the adapter's limits; nothing was allocated.
     #[error("scene too large: {0}")]
     Capacity(String),

@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 use image::RgbaImage;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use verlet::render::{self, Renderer};
+use verlet::track::Track;
 use verlet::{gpu::Gpu, output, scenes, Error, Scene, World};
 
 #[derive(Parser)]
@@ -101,6 +102,11 @@ struct RunArgs {
     /// Steps to take.
     #[arg(long)]
     steps: u64,
+    /// A scripted input track (JSON: impulses, explosions, poses,
+    /// velocities, fixed switches, wind at given times) applied between
+    /// steps. `--builtin blast` plays its own track unless this is given.
+    #[arg(long)]
+    input: Option<PathBuf>,
     /// Step length in seconds; overrides settings.dt.
     #[arg(long)]
     dt: Option<f32>,
@@ -212,6 +218,14 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if args.every == 0 {
         return Err(Error::Input("--every: must be at least 1".into()));
     }
+    let track = match (&args.input, args.builtin.as_deref()) {
+        (Some(path), _) => Some(Track::from_path(path)?),
+        (None, Some("blast")) if args.scene.is_none() => Some(scenes::blast_track()),
+        (None, _) => None,
+    };
+    if let Some(track) = &track {
+        track.check(scene.bodies.len())?;
+    }
     // The upper bound is the adapter's; Renderer::new checks it, naming the flag.
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
         if v == 0 {
@@ -234,7 +248,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let started = Instant::now();
-    let stepped = step_and_record(&args, &mut world, &mut recorder, &bar, started);
+    let stepped = step_and_record(&args, &mut world, track.as_ref(), &mut recorder, &bar, started);
     // cleared on success and on error alike, so no half-drawn bar precedes the message
     bar.finish_and_clear();
     let stage_ms = stepped?;
@@ -290,9 +304,12 @@ type StageTotals = (Vec<(verlet::step::Stage, f64)>, bool);
 /// Steps go in chunks, each waited for, so the progress bar follows the GPU
 /// rather than the submissions; a chunk grows while it takes under 0.1 s, so
 /// the waits cost little. Nothing is read back unless a recording asks for it.
+/// With an input track, a chunk ends at the next step the track acts
+/// before, and the track's inputs for a step go in just before it.
 fn step_and_record(
     args: &RunArgs,
     world: &mut World,
+    track: Option<&Track>,
     recorder: &mut Recorder,
     bar: &ProgressBar,
     started: Instant,
@@ -304,7 +321,12 @@ fn step_and_record(
     recorder.record(world)?;
     while world.step_count() < args.steps {
         let done = world.step_count();
-        let stop = if recorder.is_active() { (done / args.every + 1).saturating_mul(args.every) } else { u64::MAX };
+        let mut stop = if recorder.is_active() { (done / args.every + 1).saturating_mul(args.every) } else { u64::MAX };
+        if let Some(track) = track {
+            track.apply(world)?;
+            let dt = world.settings().dt;
+            stop = stop.min(track.next_input_step(done + 1, dt).unwrap_or(u64::MAX));
+        }
         let n = chunk.min(stop.min(args.steps) - done);
         let t = Instant::now();
         if args.profile {
