@@ -17,7 +17,23 @@ pub enum GpuError {
     Device(String),
     #[error("GPU error: {0}")]
     Runtime(String),
+    /// The device was lost (destroyed, driver reset, out of memory): every
+    /// later call on it fails with this too.
+    #[error("GPU device lost: {0}")]
+    Lost(String),
+    /// Submitted work did not finish within `WAIT_LIMIT`.
+    #[error("GPU did not finish the submitted work within {0} s (hung or lost device)")]
+    Timeout(u64),
 }
+
+/// The longest `Gpu::wait` waits for submitted work before giving up with
+/// `GpuError::Timeout`. Generous: one submission is at most a batch of
+/// steps, which on a software adapter with a huge scene takes seconds.
+pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(300);
+
+/// `Gpu::wait` polls in slices of this length, checking for a lost device
+/// between them.
+const WAIT_SLICE: std::time::Duration = std::time::Duration::from_secs(1);
 
 /// An adapter, its device and queue.
 pub struct Gpu {
@@ -31,6 +47,9 @@ pub struct Gpu {
     /// The first error the device reported outside an error scope; wgpu's
     /// default would panic, this turns it into an `Err` at the next wait.
     errors: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// Why the device was lost, once wgpu has said so (it calls the
+    /// device-lost callback while polling).
+    lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl fmt::Debug for Gpu {
@@ -96,7 +115,19 @@ impl Gpu {
                 first.get_or_insert_with(|| e.to_string().replace('\n', " "));
             }
         }));
-        Ok(Gpu { adapter, device, queue, info, limits, errors })
+        let lost = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let sink = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            if let Ok(mut first) = sink.lock() {
+                let reason = match reason {
+                    wgpu::DeviceLostReason::Destroyed => "the device was destroyed",
+                    _ => "the driver gave no reason",
+                };
+                let message = message.replace('\n', " ");
+                first.get_or_insert_with(|| if message.trim().is_empty() { reason.to_string() } else { format!("{reason}: {message}") });
+            }
+        });
+        Ok(Gpu { adapter, device, queue, info, limits, errors, lost })
     }
 
     /// One line naming the adapter, its backend and driver.
@@ -105,16 +136,31 @@ impl Gpu {
         format!("{} ({:?}, {:?}, driver {} {})", i.name, i.backend, i.device_type, i.driver, i.driver_info)
     }
 
-    /// Waits for all submitted work; reports any error the device raised.
+    /// Waits for all submitted work, at most `WAIT_LIMIT`; reports a lost
+    /// device, a timeout, or any error the device raised.
     pub fn wait(&self) -> Result<(), GpuError> {
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Runtime(e.to_string()))?;
+        let started = std::time::Instant::now();
+        loop {
+            let slice = wgpu::PollType::Wait { submission_index: None, timeout: Some(WAIT_SLICE) };
+            match self.device.poll(slice) {
+                Ok(_) => break,
+                Err(wgpu::PollError::Timeout) => {
+                    self.check()?;
+                    if started.elapsed() >= WAIT_LIMIT {
+                        return Err(GpuError::Timeout(WAIT_LIMIT.as_secs()));
+                    }
+                }
+                Err(e) => return Err(GpuError::Runtime(e.to_string())),
+            }
+        }
         self.check()
     }
 
-    /// The first error the device reported, if any.
+    /// The first error the device reported, if any; a lost device first.
     pub fn check(&self) -> Result<(), GpuError> {
+        if let Some(why) = self.lost.lock().ok().and_then(|e| e.clone()) {
+            return Err(GpuError::Lost(why));
+        }
         match self.errors.lock().ok().and_then(|e| e.clone()) {
             Some(e) => Err(GpuError::Runtime(e)),
             None => Ok(()),
@@ -137,8 +183,10 @@ impl Gpu {
             let _ = tx.send(r);
         });
         self.wait()?;
-        rx.recv()
-            .map_err(|e| GpuError::Runtime(e.to_string()))?
+        // wgpu calls back while polling, so after the wait the answer is in
+        // (or never comes, on a broken device: do not block on it)
+        rx.recv_timeout(WAIT_SLICE)
+            .map_err(|_| GpuError::Runtime("the readback's mapping never completed".into()))?
             .map_err(|e| GpuError::Runtime(e.to_string()))?;
         let bytes = staging
             .get_mapped_range(..)
