@@ -10,6 +10,7 @@ use crate::scene::{Body, Scene, Settings, Shape};
 use crate::step::{Over, Stage, StepPipelines, STORAGE_BUFFERS};
 use crate::Error;
 
+pub mod edit;
 pub mod input;
 pub mod snapshot;
 
@@ -131,6 +132,8 @@ pub struct World {
     dt_prev: f32,
     /// The user-input kernels (`input.rs`), built on the first input.
     input: Option<input::InputGpu>,
+    /// The scene as loaded or last edited (`edit.rs` rebuilds from it).
+    scene: Scene,
 }
 
 impl World {
@@ -252,6 +255,7 @@ impl World {
             time: 0.0,
             dt_prev: substep_dt,
             input: None,
+            scene: scene.clone(),
         })
     }
 

@@ -1,0 +1,94 @@
+//! Adding and removing bodies and joints while a world runs (issue 8).
+//!
+//! The GPU buffers are sized for the bodies a world holds, so an edit builds
+//! the world anew for the edited scene (new buffers, grid and joint lists,
+//! checked against the adapter's limits before anything is allocated) and
+//! carries every remaining body's pose and material across unchanged: one
+//! readback of the poses and properties, one upload. The bodies that stay
+//! continue exactly as they would have; contacts are found afresh on the
+//! next step, so a removed body leaves none behind.
+
+use std::ops::Range;
+
+use super::World;
+use crate::gpu::types::{BodyProps, BodyState};
+use crate::scene::{Body, Joint};
+use crate::Error;
+
+impl World {
+    /// Adds `bodies` at rest (or with their own initial velocities) and
+    /// `joints`, whose indices may name old and new bodies alike. Returns the
+    /// indices the new bodies got. On an error (a bad body or joint, a scene
+    /// beyond the adapter's limits) the world is left as it was.
+    pub fn add_bodies(&mut self, bodies: &[Body], joints: &[Joint]) -> Result<Range<usize>, Error> {
+        let old = self.body_count();
+        let mut scene = self.scene.clone();
+        scene.bodies.extend_from_slice(bodies);
+        scene.joints.extend_from_slice(joints);
+        let keep: Vec<Option<usize>> = (0..old).map(Some).collect();
+        self.rebuild(scene, &keep)?;
+        Ok(old..old + bodies.len())
+    }
+
+    /// Removes body `index` and every joint that names it. Bodies after it
+    /// move down one index, and joints are renumbered to match.
+    pub fn remove_body(&mut self, index: usize) -> Result<(), Error> {
+        let n = self.body_count();
+        if index >= n {
+            return Err(Error::Input(format!("index: no body {index} (the world has {n})")));
+        }
+        let mut scene = self.scene.clone();
+        scene.bodies.remove(index);
+        let gone = index as i32;
+        scene.joints.retain(|j| !j.bodies.contains(&gone));
+        for j in &mut scene.joints {
+            for b in &mut j.bodies {
+                if *b > gone {
+                    *b -= 1;
+                }
+            }
+        }
+        // the body now at k came from k, or from k + 1 past the removed one
+        let keep: Vec<Option<usize>> = (0..n - 1).map(|k| Some(if k < index { k } else { k + 1 })).collect();
+        self.rebuild(scene, &keep)
+    }
+
+    /// Builds the world for `scene`, whose body `k` is the old body
+    /// `keep[k]` for `k < keep.len()` and new beyond that.
+    fn rebuild(&mut self, scene: crate::Scene, keep: &[Option<usize>]) -> Result<(), Error> {
+        scene.validate()?;
+        let old_states = self.read_raw()?;
+        let props_bytes = self.gpu.read_buffer(self.props_buffer(), (self.body_count().max(1) * size_of::<BodyProps>()) as u64)?;
+        let old_props: Vec<BodyProps> = bytemuck::pod_collect_to_vec(&props_bytes);
+        let mut world = World::with_gpu(self.gpu.clone(), &scene)?;
+        let fresh_bytes = world.gpu.read_buffer(world.props_buffer(), (world.body_count().max(1) * size_of::<BodyProps>()) as u64)?;
+        let mut props: Vec<BodyProps> = bytemuck::pod_collect_to_vec(&fresh_bytes);
+        props.truncate(world.body_count());
+        let mut states = world.read_raw()?;
+        for (k, from) in keep.iter().enumerate() {
+            if let Some(from) = *from {
+                states[k] = old_states[from];
+                // mass, material and the fixed flag as the user last set them;
+                // whether it sits in the grid is the new world's choice
+                let large = props[k].kind[2];
+                props[k] = old_props[from];
+                props[k].kind[2] = large;
+            }
+        }
+        let queue = &world.gpu.queue;
+        queue.write_buffer(&world.data.states[world.current], 0, bytemuck::cast_slice::<BodyState, u8>(&states));
+        queue.write_buffer(world.props_buffer(), 0, bytemuck::cast_slice::<BodyProps, u8>(&props));
+        world.gpu.check()?;
+        world.step = self.step;
+        world.time = self.time;
+        world.dt_prev = self.dt_prev;
+        *self = world;
+        Ok(())
+    }
+
+    /// The buffer of the bodies' shapes, masses and materials.
+    fn props_buffer(&self) -> &wgpu::Buffer {
+        // the first of `with_gpu`'s other buffers
+        &self.data._others[0]
+    }
+}
