@@ -16,7 +16,11 @@
 @group(0) @binding(10) var<storage, read_write> contacts: array<Contact>;
 @group(0) @binding(11) var<storage, read_write> contact_count: array<u32>;
 // status[0]: most contact points any body wanted this step, status[1]: in any
-// step so far (a full contact list when either exceeds MAX_CONTACTS)
+// step so far (a full contact list when either exceeds MAX_CONTACTS), both
+// atomicMax-ed from 0; status[2], status[3]: the first numerical fault (see
+// integrate.wgsl): 4 * body + FAULT_* of the lowest body found bad in the
+// first step that found any, and that step's step_index, both atomicMin-ed
+// from NO_FAULT (0xffffffff, written when the buffer is made); 8 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1

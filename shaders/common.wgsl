@@ -43,7 +43,7 @@ struct Params {
     large_count: u32,        // bodies too large for the grid (see large[])
     speculative: f32,        // farthest gap (m) at which grid pairs get contacts
     substeps: u32,           // substeps per step: contacts found once serve them all
-    _pad1: u32,
+    step_index: u32,         // the world's step count as this step began (saturates at NO_FAULT - 1)
     _pad2: u32,
 }
 

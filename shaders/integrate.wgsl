@@ -2,6 +2,75 @@
 // eq. 7 for rotation, time-corrected for a changing dt (eq. 11) and damped
 // (eq. 12). Reads state_in, writes each body's own slot of state_out (the
 // predicted pose, with the current pose as its previous one) and of vel0.
+//
+// Numerical faults: first, every body's state as read here is checked, every
+// substep, with no readback. A body whose pose is not finite (an infinity or
+// a NaN in pos, prev_pos, rot or prev_rot), lies farther than MAX_DISTANCE
+// from the origin, or moved faster than MAX_SPEED over the last substep is
+// flagged in status[2..4] (bindings.wgsl: the lowest such body of the first
+// step that found any, with that step's index) and stopped: it is parked at
+// rest at its last sane pose (its current one if that is finite and within
+// MAX_DISTANCE, else its previous one, which passed this check last time
+// unless an input wrote it, else the origin; its rotation likewise, else
+// none) and the step goes on; the next substep integrates it again from
+// rest. Nothing else changes, so a run with no fault is bit-identical to one
+// without the check. The host reads the flag only on request
+// (World::faults, World::read_state), never in the step loop.
+
+// Beyond these a body is absurd (m, m/s).
+const MAX_DISTANCE: f32 = 1e6;
+const MAX_SPEED: f32 = 1e4;
+// status[3] (and status[2]) before any fault.
+const NO_FAULT: u32 = 0xffffffffu;
+// What was wrong, in the low two bits of status[2] (4 * body + FAULT_*).
+const FAULT_NON_FINITE: u32 = 0u;
+const FAULT_FAR: u32 = 1u;
+const FAULT_FAST: u32 = 2u;
+
+// No infinity or NaN (exponent bits all set): WGSL has no isNan, and x != x
+// may be folded away by a driver's fast-math.
+fn all_finite(v: vec4<f32>) -> bool {
+    let exponent = bitcast<vec4<u32>>(v) & vec4<u32>(0x7f800000u);
+    return all(exponent != vec4<u32>(0x7f800000u));
+}
+
+fn near(p: vec4<f32>) -> bool {
+    return all_finite(vec4<f32>(p.xyz, 0.0)) && dot(p.xyz, p.xyz) <= MAX_DISTANCE * MAX_DISTANCE;
+}
+
+fn usable_rotation(q: vec4<f32>) -> bool {
+    let d = dot(q, q);
+    return all_finite(q) && d > 1e-6 && d < 1e6;
+}
+
+// FAULT_* of a body's state, or NO_FAULT.
+fn fault_of(s: BodyState) -> u32 {
+    let finite = all_finite(vec4<f32>(s.pos.xyz, 0.0)) && all_finite(vec4<f32>(s.prev_pos.xyz, 0.0))
+        && all_finite(s.rot) && all_finite(s.prev_rot);
+    if (!finite) {
+        return FAULT_NON_FINITE;
+    }
+    if (!near(s.pos)) {
+        return FAULT_FAR;
+    }
+    let moved = s.pos.xyz - s.prev_pos.xyz;
+    let reach = MAX_SPEED * params.dt_prev;
+    if (dot(moved, moved) > reach * reach) {
+        return FAULT_FAST;
+    }
+    return NO_FAULT;
+}
+
+// Records a fault of body i unless an earlier step already recorded one:
+// within one dispatch every thread has the same step_index, and dispatches
+// run in order, so status[2] and status[3] always describe the same event.
+fn report_fault(i: u32, fault: u32) {
+    let first = atomicLoad(&status[3]);
+    if (first == NO_FAULT || first == params.step_index) {
+        atomicMin(&status[3], params.step_index);
+        atomicMin(&status[2], 4u * i + fault);
+    }
+}
 
 @compute @workgroup_size(WORKGROUP)
 fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -16,6 +85,25 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let first = i * MAX_CONTACTS;
     for (var k = first; k < first + contact_count[i]; k = k + 1u) {
         contacts[k].pushed = 0.0;
+    }
+    let fault = fault_of(s);
+    if (fault != NO_FAULT) {
+        report_fault(i, fault);
+        var at = vec3<f32>(0.0);
+        if (near(s.pos)) {
+            at = s.pos.xyz;
+        } else if (near(s.prev_pos)) {
+            at = s.prev_pos.xyz;
+        }
+        var q = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        if (usable_rotation(s.rot)) {
+            q = normalize(s.rot);
+        } else if (usable_rotation(s.prev_rot)) {
+            q = normalize(s.prev_rot);
+        }
+        state_out[i] = BodyState(vec4<f32>(at, 0.0), vec4<f32>(at, 0.0), q, q);
+        vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
+        return;
     }
     if (is_fixed(p)) {
         state_out[i] = BodyState(s.pos, s.pos, s.rot, s.rot);

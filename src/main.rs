@@ -252,6 +252,12 @@ fn run(args: RunArgs) -> Result<(), Error> {
     // cleared on success and on error alike, so no half-drawn bar precedes the message
     bar.finish_and_clear();
     let stage_ms = stepped?;
+    // The GPU flags a non-finite or absurd body every step without a
+    // readback; the run reads the flag here once (and read_state, which
+    // every trace row calls, reads it too) and fails naming body and step.
+    if let Some(fault) = world.faults()? {
+        return Err(Error::Diverged(fault.to_string()));
+    }
     let bodies = world.read_state()?;
     let wall = started.elapsed();
     let frames_written = recorder.frames_written;

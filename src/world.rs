@@ -99,6 +99,54 @@ pub struct ContactReport {
     pub capacity: u32,
 }
 
+/// Bytes of the `status` buffer the GPU reports through (8 words; see
+/// shaders/bindings.wgsl, binding 12).
+const STATUS_BYTES: u64 = 32;
+/// `status[2]` and `status[3]` before any fault (`NO_FAULT` in integrate.wgsl).
+pub const NO_FAULT: u32 = u32::MAX;
+/// The speed (m/s) and distance from the origin (m) beyond which a body's
+/// state is absurd (`MAX_SPEED`, `MAX_DISTANCE` in integrate.wgsl).
+pub const MAX_SPEED: f32 = 1e4;
+pub const MAX_DISTANCE: f32 = 1e6;
+
+/// What was wrong with a faulted body (the low two bits of `status[2]`,
+/// `FAULT_*` in integrate.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FaultKind {
+    /// An infinity or a NaN in its pose.
+    NonFinite,
+    /// Farther than `MAX_DISTANCE` from the origin.
+    TooFar,
+    /// Faster than `MAX_SPEED`.
+    TooFast,
+}
+
+/// The first numerical fault the GPU found: the lowest body found bad in the
+/// first step that found any. The integration checks every body's state
+/// every substep (no readback); a bad body is stopped, parked at rest at
+/// its last sane pose, and the run goes on (see shaders/integrate.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fault {
+    pub body: usize,
+    /// The step (0-based: the world's step count as it began) whose
+    /// integration found the bad state: the state went bad during it
+    /// (between substeps), during the step before, or through the scene or
+    /// an input given before it.
+    pub step: u64,
+    pub kind: FaultKind,
+}
+
+impl std::fmt::Display for Fault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let what = match self.kind {
+            FaultKind::NonFinite => "non-finite".to_string(),
+            FaultKind::TooFar => format!("absurd (farther than {MAX_DISTANCE:e} m from the origin)"),
+            FaultKind::TooFast => format!("absurd (faster than {MAX_SPEED:e} m/s)"),
+        };
+        write!(f, "body {} became {what} at step {}; it was stopped at its last sane pose", self.body, self.step)
+    }
+}
+
 impl ContactReport {
     pub fn overflowed(&self) -> bool {
         self.run_max > self.capacity
@@ -190,7 +238,7 @@ impl World {
         let large_buf = with_data("grid/large", bytemuck::cast_slice(&large));
         let contacts = storage("contacts", count as u64 * MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64);
         let contact_count = storage("contact_count", 4 * count as u64);
-        let status = storage("status", 16);
+        let status = with_data("status", bytemuck::cast_slice(&STATUS_INIT));
         let (starts, refs) = joint_lists(scene);
         let joint_start = with_data("joints/start", bytemuck::cast_slice(&starts));
         let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&refs));
@@ -301,7 +349,10 @@ impl World {
 
     /// Takes one step per entry of `dts`, each of that length (s); Verlet's
     /// time correction (eq. 11) carries the motion across changes of dt.
+    /// A lost device or any error it raised is reported here, by the next
+    /// call after it happened.
     pub fn step_with(&mut self, dts: &[f32]) -> Result<(), Error> {
+        self.gpu.check()?;
         for (k, &dt) in dts.iter().enumerate() {
             if !(dt.is_finite() && dt > 0.0) {
                 return Err(Error::Input(format!("dt[{k}]: must be a positive finite number of seconds, got {dt}")));
@@ -322,8 +373,10 @@ impl World {
         let mut slots = vec![0u8; PARAMS_STRIDE as usize * dts.len() * substeps];
         let mut dt_prev = self.dt_prev;
         let mut slot = 0;
-        for &dt in dts {
+        for (k, &dt) in dts.iter().enumerate() {
             let h = dt / substeps as f32;
+            // NO_FAULT is reserved: the step index saturates just below it
+            let step_index = (self.step + k as u64).min(NO_FAULT as u64 - 1) as u32;
             for _ in 0..substeps {
                 let p = Params {
                     gravity: [s.gravity[0], s.gravity[1], s.gravity[2], self.ground.unwrap_or(0.0)],
@@ -342,6 +395,7 @@ impl World {
                     large_count: self.large_count,
                     speculative: self.grid.speculative,
                     substeps: substeps as u32,
+                    step_index,
                     ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;
@@ -512,6 +566,23 @@ impl World {
         Ok(ContactReport { last_step_max: v[0], run_max: v[1], capacity: MAX_CONTACTS })
     }
 
+    /// The first numerical fault since the world was made or
+    /// [`World::clear_faults`], if any (a 32-byte blocking readback; the
+    /// step loop never reads it).
+    pub fn faults(&self) -> Result<Option<Fault>, Error> {
+        let bytes = self.gpu.read_buffer(&self.data.status, STATUS_BYTES)?;
+        let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(decode_fault(v[2], v[3]))
+    }
+
+    /// Forgets the recorded fault, so that the next one is reported (the
+    /// faulted body stays where it was stopped).
+    pub fn clear_faults(&mut self) -> Result<(), Error> {
+        self.gpu.check()?;
+        self.gpu.queue.write_buffer(&self.data.status, 8, bytemuck::cast_slice(&[NO_FAULT, NO_FAULT]));
+        Ok(())
+    }
+
     /// The contact points each body gathered in the last step's narrowphase
     /// (a blocking readback, for tests and debugging).
     pub fn read_contacts(&self) -> Result<Vec<Vec<Contact>>, Error> {
@@ -536,10 +607,16 @@ impl World {
         Ok(states)
     }
 
-    /// Reads every body's state back (a blocking readback).
+    /// Reads every body's state back (a blocking readback). Fails with
+    /// `Error::Diverged`, naming the body and the step, once the GPU has
+    /// flagged a numerical fault (see [`World::faults`]; after
+    /// [`World::clear_faults`] it reads again) or a state is not finite.
     pub fn read_state(&self) -> Result<Vec<BodyOutput>, Error> {
         let dt = self.dt_prev as f64;
         let states = self.read_raw()?;
+        if let Some(fault) = self.faults()? {
+            return Err(Error::Diverged(fault.to_string()));
+        }
         let out: Vec<BodyOutput> = states.iter().map(|s| body_output(s, dt)).collect();
         if let Some(k) = out.iter().position(|b| !finite_output(b)) {
             return Err(Error::Diverged(format!(
@@ -551,9 +628,26 @@ impl World {
     }
 }
 
+/// The status words as made: contact maxima 0 (atomicMax-ed), no fault
+/// (atomicMin-ed), the rest spare.
+const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] = [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0];
+
 /// The damping per substep that removes `beta` per step: 1 - (1 - beta)^(1/n).
 fn per_substep(beta: f32, substeps: usize) -> f32 {
     1.0 - (1.0 - beta as f64).powf(1.0 / substeps as f64) as f32
+}
+
+/// The fault `status[2]` and `status[3]` describe, if any.
+fn decode_fault(code: u32, step: u32) -> Option<Fault> {
+    if step == NO_FAULT || code == NO_FAULT {
+        return None;
+    }
+    let kind = match code & 3 {
+        0 => FaultKind::NonFinite,
+        1 => FaultKind::TooFar,
+        _ => FaultKind::TooFast,
+    };
+    Some(Fault { body: (code / 4) as usize, step: step as u64, kind })
 }
 
 fn finite_output(b: &BodyOutput) -> bool {

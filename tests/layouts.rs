@@ -40,7 +40,7 @@ fn shared_structs_match_member_by_member() {
         Params {
             gravity, dt, dt_prev, relaxation, linear_damping, angular_damping, body_count, has_ground,
             ground_restitution, ground_friction, cell_size, hash_size, large_count, speculative,
-            substeps, _pad1, _pad2
+            substeps, step_index, _pad2
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });
@@ -64,6 +64,19 @@ fn constants_match() {
     assert_eq!(find("MAX_CONTACTS"), MAX_CONTACTS);
     assert_eq!(find("GROUND"), GROUND);
     assert_eq!(find("WORLD"), WORLD);
+    // the numerical-fault codes the host decodes (src/world.rs)
+    let integrate = verlet::gpu::shaders::pass_source("integrate").unwrap();
+    let module = shaders::validate(&integrate).unwrap();
+    let constant = |name: &str| {
+        let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
+        module.global_expressions[c.init].clone()
+    };
+    assert!(matches!(constant("NO_FAULT"), naga::Expression::Literal(naga::Literal::U32(verlet::world::NO_FAULT))));
+    assert!(matches!(constant("MAX_SPEED"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_SPEED));
+    assert!(matches!(constant("MAX_DISTANCE"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_DISTANCE));
+    for (name, code) in [("FAULT_NON_FINITE", 0u32), ("FAULT_FAR", 1), ("FAULT_FAST", 2)] {
+        assert!(matches!(constant(name), naga::Expression::Literal(naga::Literal::U32(v)) if v == code), "{name}");
+    }
     let grid = format!("{}{}{}", shaders::COMMON, shaders::BINDINGS, shaders::GRID);
     let module = shaders::validate(&grid).unwrap();
     let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some("SCAN_BLOCK")).unwrap();

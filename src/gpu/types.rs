@@ -65,7 +65,9 @@ pub struct Params {
     pub speculative: f32,
     /// Substeps per step; contacts found once per step serve them all.
     pub substeps: u32,
-    pub _pad1: u32,
+    /// The world's step count as this step began (saturating at
+    /// `u32::MAX - 1`): the step a numerical fault is reported at.
+    pub step_index: u32,
     pub _pad2: u32,
 }
 

@@ -1,0 +1,186 @@
+//! Numerical faults (issue 7, part 3): the GPU flags, every step and with no
+//! readback, a body whose state is non-finite or absurd (beyond 1e6 m or
+//! 1e4 m/s); the library reports which body and which step, the body is
+//! stopped at its last sane pose, the others go on untouched, and
+//! `verlet run` fails naming body and step.
+
+mod common;
+
+use std::process::Command;
+
+use verlet::gpu::types::BodyState;
+use verlet::world::{Fault, FaultKind};
+use verlet::{scenes, Error, Scene, World};
+
+/// Five unit boxes on the ground, 10 m apart: they never touch.
+fn row() -> Scene {
+    let mut scene = scenes::stack(0);
+    scene.bodies = (0..5).map(|k| scenes::box_body([0.5; 3], [10.0 * k as f32, 0.5, 0.0])).collect();
+    scene
+}
+
+fn raw(world: &World) -> Vec<BodyState> {
+    world.read_raw().unwrap()
+}
+
+fn finite(s: &BodyState) -> bool {
+    s.pos.iter().chain(&s.prev_pos).chain(&s.rot).chain(&s.prev_rot).all(|v| v.is_finite())
+}
+
+/// A state the host sees as sane: finite, near, not fast.
+fn sane(s: &BodyState, dt: f32) -> bool {
+    let p = common::v3([s.pos[0], s.pos[1], s.pos[2]]);
+    let q = common::v3([s.prev_pos[0], s.prev_pos[1], s.prev_pos[2]]);
+    finite(s) && p.length() < 1e3 && (p - q).length() / dt < 100.0
+}
+
+#[test]
+fn absurd_initial_velocity_is_flagged_and_the_others_are_untouched() {
+    let mut bad = row();
+    bad.bodies[2].linear_velocity = [1e5, 0.0, 0.0];
+    // the scene loader takes it: finite is all it asks
+    let bad = Scene::from_json_str(&bad.to_json()).expect("the loader accepts 1e5 m/s");
+    let Some(mut world) = common::world(&bad) else { return };
+    let mut clean = common::world(&row()).unwrap();
+    assert_eq!(world.faults().unwrap(), None, "no fault before any step");
+    world.step(120).unwrap();
+    clean.step(120).unwrap();
+
+    let fault = world.faults().unwrap().expect("the fast body is flagged");
+    assert_eq!(fault, Fault { body: 2, step: 0, kind: FaultKind::TooFast });
+    let (a, b) = (raw(&world), raw(&clean));
+    for k in [0, 1, 3, 4] {
+        assert_eq!(a[k], b[k], "body {k} differs from the run without the bad body");
+    }
+    // stopped where it started, then it went on from rest: it sits on the ground
+    let dt = world.settings().dt / world.settings().substeps as f32;
+    assert!(sane(&a[2], dt), "the stopped body: {:?}", a[2]);
+    assert!((a[2].pos[0] - 20.0).abs() < 1e-3 && (a[2].pos[1] - 0.5).abs() < 0.05, "parked at {:?}", a[2].pos);
+
+    match world.read_state() {
+        Err(Error::Diverged(why)) => {
+            assert!(why.contains("body 2 became absurd") && why.contains("at step 0"), "{why}");
+        }
+        other => panic!("read_state after a fault: {other:?}"),
+    }
+    world.clear_faults().unwrap();
+    assert_eq!(world.faults().unwrap(), None);
+    world.step(10).unwrap();
+    assert_eq!(world.faults().unwrap(), None, "the stopped body is sane again");
+    assert!(world.read_state().is_ok());
+}
+
+#[test]
+fn the_first_fault_is_kept_with_its_own_step() {
+    let Some(mut world) = common::world(&row()) else { return };
+    world.step(10).unwrap();
+    assert_eq!(world.faults().unwrap(), None);
+    // two bodies go wrong before step 10, a lower one before step 20
+    world.set_velocity(4, [0.0, 2e4, 0.0], [0.0; 3]).unwrap();
+    world.set_velocity(3, [0.0, 0.0, -3e4], [0.0; 3]).unwrap();
+    world.step(10).unwrap();
+    world.set_velocity(0, [5e4, 0.0, 0.0], [0.0; 3]).unwrap();
+    world.step(10).unwrap();
+    let fault = world.faults().unwrap().expect("flagged");
+    assert_eq!(fault, Fault { body: 3, step: 10, kind: FaultKind::TooFast }, "the lowest body of the first step");
+    let dt = world.settings().dt / world.settings().substeps as f32;
+    for (k, s) in raw(&world).iter().enumerate() {
+        assert!(sane(s, dt), "body {k}: {s:?}");
+    }
+    // once cleared, the next fault is reported: body 0's is now in the past
+    world.clear_faults().unwrap();
+    world.step(5).unwrap();
+    assert_eq!(world.faults().unwrap(), None);
+    world.set_pose(1, [2e6, 0.5, 0.0], [0.0, 0.0, 0.0, 1.0]).unwrap();
+    world.step(5).unwrap();
+    let fault = world.faults().unwrap().expect("flagged");
+    assert_eq!(fault, Fault { body: 1, step: 35, kind: FaultKind::TooFar });
+}
+
+#[test]
+fn a_nan_is_flagged_and_the_body_parked_at_its_previous_pose() {
+    let Some(mut world) = common::world(&row()) else { return };
+    let mut clean = common::world(&row()).unwrap();
+    world.step(5).unwrap();
+    clean.step(5).unwrap();
+    // poison body 3's current position directly in the state buffer
+    let before = raw(&world)[3];
+    let mut poisoned = before;
+    poisoned.pos[1] = f32::NAN;
+    let at = 3 * std::mem::size_of::<BodyState>() as u64;
+    world.gpu().queue.write_buffer(world.current_state_buffer(), at, bytemuck::bytes_of(&poisoned));
+    world.step(20).unwrap();
+    clean.step(20).unwrap();
+    assert_eq!(world.faults().unwrap(), Some(Fault { body: 3, step: 5, kind: FaultKind::NonFinite }));
+    let (a, b) = (raw(&world), raw(&clean));
+    for k in [0, 1, 2, 4] {
+        assert_eq!(a[k], b[k], "body {k} differs from the clean run");
+    }
+    let dt = world.settings().dt / world.settings().substeps as f32;
+    assert!(sane(&a[3], dt), "the NaN body was not parked: {:?}", a[3]);
+    assert!((a[3].pos[0] - before.prev_pos[0]).abs() < 1e-3, "parked at {:?}, was at {:?}", a[3].pos, before.prev_pos);
+    let why = world.read_state().unwrap_err().to_string();
+    assert!(why.contains("body 3 became non-finite at step 5"), "{why}");
+}
+
+#[test]
+fn a_clean_run_of_1000_steps_reports_no_fault() {
+    let Some(mut world) = common::world(&scenes::cubes(100, 3)) else { return };
+    world.step(1000).unwrap();
+    assert_eq!(world.faults().unwrap(), None);
+    let bodies = world.read_state().expect("no fault, no divergence");
+    assert!(bodies.iter().all(|b| b.position[1] > 0.0 && b.position[1] < 10.0));
+}
+
+fn write(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn the_command_line_fails_naming_body_and_step() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("verlet-faults-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut scene = row();
+    scene.bodies[1].linear_velocity = [0.0, 0.0, 2e5];
+    let bad = write(&dir, "bad.json", &scene.to_json());
+    let clean = write(&dir, "clean.json", &row().to_json());
+    // body 4 thrown at 1e5 m/s by a track before step 30 (t = 0.5 s at dt = 1/60)
+    let track = write(&dir, "throw.json", r#"{"events": [{"t": 0.5, "set_velocity": {"body": 4, "linear": [1e5, 0, 0]}}]}"#);
+    let run = |args: &[&std::ffi::OsStr]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_verlet")).arg("run").args(args).output().expect("verlet runs");
+        (out.status, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (status, stderr) = run(&[bad.as_os_str(), "--steps".as_ref(), "50".as_ref()]);
+    assert!(!status.success(), "a faulted run must fail");
+    assert!(stderr.contains("body 1 became absurd") && stderr.contains("at step 0"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+
+    let (status, stderr) = run(&[clean.as_os_str(), "--steps".as_ref(), "60".as_ref(), "--input".as_ref(), track.as_os_str()]);
+    assert!(!status.success(), "a faulted run must fail");
+    assert!(stderr.contains("body 4 became absurd") && stderr.contains("at step 30"), "{stderr}");
+
+    // with a trace, the row read after the fault stops the run
+    let trace = dir.join("trace.csv");
+    let (status, stderr) = run(&[
+        clean.as_os_str(),
+        "--steps".as_ref(),
+        "60".as_ref(),
+        "--input".as_ref(),
+        track.as_os_str(),
+        "--trace".as_ref(),
+        trace.as_os_str(),
+        "--every".as_ref(),
+        "10".as_ref(),
+    ]);
+    assert!(!status.success());
+    assert!(stderr.contains("body 4 became absurd (faster than 1e4 m/s) at step 30"), "{stderr}");
+
+    let (status, stderr) = run(&[clean.as_os_str(), "--steps".as_ref(), "60".as_ref()]);
+    assert!(status.success(), "a clean run fails: {stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
