@@ -405,6 +405,23 @@ impl Scene {
 /// Turns a serde_json error, and the path of the field it happened in (as
 /// tracked by serde_path_to_error), into a [`SceneError`].
 fn json_error(field: Option<String>, inner: serde_json::Error) -> SceneError {
+    match classify_json_error(field, inner, "scene") {
+        JsonFault::Invalid { field, message } => SceneError::Invalid { field, message },
+        JsonFault::Syntax { line, column, message } => SceneError::Syntax { line, column, message },
+    }
+}
+
+/// A serde_json error as the JSON loaders (scenes, input tracks) report it.
+pub(crate) enum JsonFault {
+    /// A field is unknown, of the wrong type, or a number beyond any float.
+    Invalid { field: String, message: String },
+    /// The text is not JSON.
+    Syntax { line: usize, column: usize, message: String },
+}
+
+/// Classifies a serde_json error raised in `field` (None: the top level,
+/// named `top` in the message).
+pub(crate) fn classify_json_error(field: Option<String>, inner: serde_json::Error, top: &str) -> JsonFault {
     let (line, column) = (inner.line(), inner.column());
     // serde_json's message ends with " at line L column C"; we place the
     // position ourselves.
@@ -417,16 +434,16 @@ fn json_error(field: Option<String>, inner: serde_json::Error) -> SceneError {
     match (inner.classify(), field) {
         // A number too large for any float (like 1e999) is valid JSON
         // grammar but not a usable value: blame the field it is in.
-        (Category::Syntax, Some(field)) if number_out_of_range => SceneError::invalid(
+        (Category::Syntax, Some(field)) if number_out_of_range => JsonFault::Invalid {
             field,
-            format!("number out of range, must be finite (line {line}, column {column})"),
-        ),
+            message: format!("number out of range, must be finite (line {line}, column {column})"),
+        },
         // Unknown field, wrong type, out-of-range integer, ...
-        (Category::Data, field) => SceneError::invalid(
-            field.unwrap_or_else(|| "scene".to_string()),
-            format!("{message} (line {line}, column {column})"),
-        ),
-        (Category::Syntax | Category::Eof | Category::Io, field) => SceneError::Syntax {
+        (Category::Data, field) => JsonFault::Invalid {
+            field: field.unwrap_or_else(|| top.to_string()),
+            message: format!("{message} (line {line}, column {column})"),
+        },
+        (Category::Syntax | Category::Eof | Category::Io, field) => JsonFault::Syntax {
             line,
             column,
             message: match field {
@@ -439,7 +456,7 @@ fn json_error(field: Option<String>, inner: serde_json::Error) -> SceneError {
 
 /// Writes a serde_path_to_error path as `bodies[3].shape.half_extents[1]`;
 /// `None` for the top level.
-fn path_string(path: &serde_path_to_error::Path) -> Option<String> {
+pub(crate) fn path_string(path: &serde_path_to_error::Path) -> Option<String> {
     use serde_path_to_error::Segment;
     let mut out = String::new();
     for segment in path.iter() {
@@ -467,7 +484,7 @@ fn path_string(path: &serde_path_to_error::Path) -> Option<String> {
 
 /// Escapes control characters (newlines in a field name, say) so that an
 /// error message stays on one line.
-fn one_line(text: &str) -> String {
+pub(crate) fn one_line(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
         if c.is_control() {
@@ -488,7 +505,7 @@ fn one_line(text: &str) -> String {
 /// Deserializes `T` from a JSON object only. Serde's derived structs also
 /// accept an array of field values in declaration order, which a scene file
 /// never means; this refuses it with "expected a JSON object".
-struct Obj<T>(T);
+pub(crate) struct Obj<T>(pub(crate) T);
 
 impl<'de, T: Deserialize<'de>> Deserialize<'de> for Obj<T> {
     fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {

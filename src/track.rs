@@ -42,11 +42,11 @@
 //! field as the scene loader does (`events[2].impulse.body: no body 40 (the
 //! scene has 12 bodies)`), with indices as in the file.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use crate::scene::{classify_json_error, one_line, path_string, JsonFault, Obj};
 use crate::world::input::{BodyInput, Point, Wind};
 use crate::{Error, World};
 
@@ -570,83 +570,9 @@ impl RawEvent {
 // JSON errors, as scene.rs reports them
 // ---------------------------------------------------------------------------
 
-/// Deserializes `T` from a JSON object only (not serde's array form).
-struct Obj<T>(T);
-
-impl<'de, T: Deserialize<'de>> Deserialize<'de> for Obj<T> {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        struct ObjectVisitor<T>(std::marker::PhantomData<T>);
-
-        impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for ObjectVisitor<T> {
-            type Value = T;
-
-            fn expecting(&self, formatter: &mut std::fmt::Formatter) -> std::fmt::Result {
-                formatter.write_str("a JSON object")
-            }
-
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
-                T::deserialize(serde::de::value::MapAccessDeserializer::new(map))
-            }
-        }
-
-        deserializer.deserialize_map(ObjectVisitor(std::marker::PhantomData)).map(Obj)
-    }
-}
-
 fn json_error(field: Option<String>, inner: serde_json::Error) -> TrackError {
-    let (line, column) = (inner.line(), inner.column());
-    let full = inner.to_string();
-    let suffix = format!(" at line {line} column {column}");
-    let message = one_line(full.strip_suffix(&suffix).unwrap_or(&full));
-    use serde_json::error::Category;
-    match (inner.classify(), field) {
-        (Category::Syntax, Some(field)) if message.starts_with("number out of range") => TrackError::invalid(
-            field,
-            format!("number out of range, must be finite (line {line}, column {column})"),
-        ),
-        (Category::Data, field) => TrackError::invalid(
-            field.unwrap_or_else(|| "track".to_string()),
-            format!("{message} (line {line}, column {column})"),
-        ),
-        (Category::Syntax | Category::Eof | Category::Io, field) => TrackError::Syntax {
-            line,
-            column,
-            message: match field {
-                Some(field) => format!("{message} (in {field})"),
-                None => message,
-            },
-        },
+    match classify_json_error(field, inner, "track") {
+        JsonFault::Invalid { field, message } => TrackError::Invalid { field, message },
+        JsonFault::Syntax { line, column, message } => TrackError::Syntax { line, column, message },
     }
-}
-
-fn path_string(path: &serde_path_to_error::Path) -> Option<String> {
-    use serde_path_to_error::Segment;
-    let mut out = String::new();
-    for segment in path.iter() {
-        match segment {
-            Segment::Seq { index } => {
-                let _ = write!(out, "[{index}]");
-            }
-            Segment::Map { key } | Segment::Enum { variant: key } => {
-                if !out.is_empty() {
-                    out.push('.');
-                }
-                out.push_str(&one_line(key));
-            }
-            Segment::Unknown => {}
-        }
-    }
-    (!out.is_empty()).then_some(out)
-}
-
-fn one_line(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
 }
