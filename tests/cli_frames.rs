@@ -1,34 +1,10 @@
 //! `verlet run --frames`: the binary writes the frames INTERFACE.md section 3
 //! promises, and refuses bad image flags cleanly.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
 
-/// A fresh, empty directory under the system temp dir, unique to this test.
-fn temp_dir(name: &str) -> PathBuf {
-    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!("verlet-cli-frames-{name}-{}-{nanos}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
+mod common;
 
-fn verlet(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_verlet")).args(args).output().expect("the verlet binary runs")
-}
-
-/// True when the run failed only for want of an adapter: a loud skip, or a
-/// failure under CI (as tests/common/mod.rs does for the library tests).
-fn no_adapter(output: &Output) -> bool {
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if output.status.success() || !stderr.contains("no GPU adapter found") {
-        return false;
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!("CI is set but the binary found no GPU adapter: {stderr}");
-    }
-    eprintln!("\n!!!!! SKIPPING GPU TEST: the binary found no adapter ({}) !!!!!\n", stderr.trim());
-    true
-}
+use common::{no_adapter, temp_path as temp_dir, verlet};
 
 #[test]
 fn frames_are_written_every_k_steps_at_the_asked_size() {

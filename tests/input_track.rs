@@ -5,9 +5,6 @@
 
 mod common;
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
 use verlet::scenes::{self, sphere_body};
 use verlet::track::{Action, Event, Track, TrackError};
 use verlet::world::input::Wind;
@@ -200,27 +197,7 @@ fn a_wind_event_blows_over_its_duration_only() {
 // The command line
 // ---------------------------------------------------------------------------
 
-fn temp_path(name: &str) -> PathBuf {
-    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos());
-    std::env::temp_dir().join(format!("verlet-input-track-{name}-{}-{nanos}", std::process::id()))
-}
-
-fn verlet(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_verlet")).args(args).output().expect("the verlet binary runs")
-}
-
-/// True when the run failed only for want of an adapter (see tests/cli_frames.rs).
-fn no_adapter(output: &Output) -> bool {
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if output.status.success() || !stderr.contains("no GPU adapter found") {
-        return false;
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!("CI is set but the binary found no GPU adapter: {stderr}");
-    }
-    eprintln!("\n!!!!! SKIPPING GPU TEST: the binary found no adapter ({}) !!!!!\n", stderr.trim());
-    true
-}
+use common::{no_adapter, temp_path, verlet};
 
 /// Positions after `steps` steps of `verlet run --builtin blast [extra...]`,
 /// or None when there is no adapter.

@@ -36,3 +36,30 @@ pub fn v3(a: [f32; 3]) -> glam::Vec3 {
 pub fn quat(a: [f32; 4]) -> glam::Quat {
     glam::Quat::from_array(a)
 }
+
+/// A path under the system temp dir unique to this test run (nothing there).
+pub fn temp_path(name: &str) -> std::path::PathBuf {
+    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos());
+    let path = std::env::temp_dir().join(format!("verlet-test-{name}-{}-{nanos}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&path);
+    path
+}
+
+/// Runs the `verlet` binary with `args`.
+pub fn verlet(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_verlet")).args(args).output().expect("the verlet binary runs")
+}
+
+/// True when the run failed only for want of an adapter: a loud skip, or a
+/// failure under CI (as `gpu` does for the library tests).
+pub fn no_adapter(output: &std::process::Output) -> bool {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if output.status.success() || !stderr.contains("no GPU adapter found") {
+        return false;
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!("CI is set but the binary found no GPU adapter: {stderr}");
+    }
+    eprintln!("\n!!!!! SKIPPING GPU TEST: the binary found no adapter ({}) !!!!!\n", stderr.trim());
+    true
+}
