@@ -256,6 +256,10 @@ pub struct CaseResult {
     pub contacts_overflowed: bool,
     /// Mean height of the movable bodies after the last repetition (m).
     pub mean_height: f64,
+    /// The machine's 1-minute load average when the case started and ended
+    /// (Linux): above the core count, other work shared the CPU (and so
+    /// lavapipe) and the times are inflated.
+    pub load_avg: Option<[f64; 2]>,
     pub peer: Option<PeerResult>,
 }
 
@@ -359,6 +363,11 @@ pub fn gpu_bytes(scene: &Scene) -> u64 {
         + joints
 }
 
+/// The 1-minute load average (Linux).
+pub fn load_avg() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
+}
+
 fn mean_height(bodies: impl Iterator<Item = f32>) -> f64 {
     let (sum, count) = bodies.fold((0.0f64, 0usize), |(s, c), y| (s + y as f64, c + 1));
     if count == 0 {
@@ -402,7 +411,7 @@ impl CopyKernel {
     pub fn new(gpu: &Gpu, n: usize) -> Result<CopyKernel, Error> {
         let device = &gpu.device;
         let bytes = (n.max(1) * std::mem::size_of::<BodyState>()) as u64;
-        if bytes > (gpu.limits.max_storage_buffer_binding_size as u64).min(gpu.limits.max_buffer_size) {
+        if bytes > gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size) {
             return Err(Error::Capacity(format!("copy kernel: {n} states do not fit one storage binding")));
         }
         let storage = |label: &str| {
@@ -547,8 +556,8 @@ pub mod peer {
     impl RapierWorld {
         pub fn new(scene: &Scene, sleeping: bool, iterations: Option<usize>) -> RapierWorld {
             let s = &scene.settings;
-            let mut w = PhysicsWorld::default();
-            w.gravity = Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]);
+            let mut w =
+                PhysicsWorld { gravity: Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]), ..Default::default() };
             w.integration_parameters.dt = s.dt;
             if let Some(k) = iterations {
                 w.integration_parameters.num_solver_iterations = k.max(1);
@@ -668,13 +677,15 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
         "bench: {} (up to {steps} steps, at most {body_steps} body-steps, x {reps} reps per case)",
         gpu.describe()
     );
-    let mesa_cache = std::env::var("MESA_SHADER_CACHE_DISABLE").map_or(false, |v| v == "true" || v == "1");
+    let mesa_cache = std::env::var("MESA_SHADER_CACHE_DISABLE").is_ok_and(|v| v == "true" || v == "1");
 
     let settings = crate::Settings::default();
     let (peer_name, iterations) = peer_description(opts, &settings);
     let mut results = Vec::new();
     for case in &cases {
-        let r = run_case(&gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
+        let before = load_avg();
+        let mut r = run_case(&gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
+        r.load_avg = before.zip(load_avg()).map(|(a, b)| [a, b]);
         results.push(r);
     }
     // Rendering comes last: on lavapipe (Mesa 22.3) compute-pass timestamps
@@ -692,7 +703,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
         adapter: gpu.describe(),
         gpu_timestamps: timestamps,
         max_bodies: max,
-        max_storage_buffer_binding_size: gpu.limits.max_storage_buffer_binding_size as u64,
+        max_storage_buffer_binding_size: gpu.limits.max_storage_buffer_binding_size,
         bytes_per_body: world::bytes_per_body(),
         iterations,
         peer: peer_name,
@@ -797,6 +808,7 @@ fn blank(case: &Case, scene: &Scene, steps: u64, reps: usize) -> CaseResult {
         max_contacts: 0,
         contacts_overflowed: false,
         mean_height: f64::NAN,
+        load_avg: None,
         peer: None,
     }
 }
@@ -1079,7 +1091,16 @@ pub fn table(r: &Report) -> String {
     let _ = writeln!(s, "shader cache: {}", r.shader_cache);
     let _ = writeln!(s, "peer:    {}", r.peer);
     let _ = writeln!(s, "solver:  {}", r.iterations);
-    let _ = writeln!(s, "command: {}\n", r.command);
+    let _ = writeln!(s, "command: {}", r.command);
+    let busiest = r.cases.iter().filter_map(|c| c.load_avg).flatten().fold(0.0f64, f64::max);
+    if busiest > r.cores as f64 + 0.5 {
+        let _ = writeln!(
+            s,
+            "warning: the machine was busy (1-minute load average up to {busiest:.1} on {} cores): other work shared the CPU, so every time below is inflated",
+            r.cores
+        );
+    }
+    let _ = writeln!(s);
     let _ = writeln!(
         s,
         "| case | bodies | steps x reps | start-up s | ms/step (median) | body-steps/s | GPU MiB | B/body | rapier ms/step | rapier body-steps/s | speed-up |"
@@ -1146,19 +1167,23 @@ pub fn table(r: &Report) -> String {
         }
     }
     let _ = writeln!(s, "\nsanity (after the last repetition):\n");
-    let _ = writeln!(s, "| case | first step ms | set-up s (cached) | mean height m | rapier mean height m | max contacts/body | overflow |");
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(
+        s,
+        "| case | first step ms | set-up s (cached) | mean height m | rapier mean height m | max contacts/body | overflow | load avg start/end |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---|---:|");
     for c in r.cases.iter().filter(|c| c.skipped.is_none()) {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.2} | {:.3} | {} | {} | {} |",
+            "| {} | {} | {:.2} | {:.3} | {} | {} | {} | {} |",
             c.case,
             fmt_ms(c.first_step_ms),
             c.setup_s,
             c.mean_height,
             c.peer.as_ref().map_or("-".into(), |p| format!("{:.3}", p.mean_height)),
             c.max_contacts,
-            if c.contacts_overflowed { "yes" } else { "no" }
+            if c.contacts_overflowed { "yes" } else { "no" },
+            c.load_avg.map_or("-".into(), |[a, b]| format!("{a:.1} / {b:.1}"))
         );
     }
     for c in &r.cases {
