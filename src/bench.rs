@@ -7,9 +7,10 @@
 //!    compiled — slow on lavapipe, which JIT-compiles every kernel with LLVM —
 //!    and buffers uploaded) and its first step, timed apart from everything
 //!    else and then thrown away;
-//! 2. **repetitions**: `reps` fresh worlds of the same scene, each timed over
-//!    the same `steps` steps from the same initial state (wall clock from the
-//!    first submission to the GPU going idle); the median is reported;
+//! 2. **repetitions**: `reps` fresh worlds of the same scene, each taking one
+//!    untimed step (lavapipe loads a world's pipelines at first dispatch) and
+//!    then timed over the same `steps` steps (wall clock from the first
+//!    submission to the GPU going idle); the median is reported;
 //! 3. **per stage**: `World::profile` over a few more steps of the last
 //!    repetition's world (GPU timestamp queries where the adapter has them,
 //!    else the wall clock around each pass), a blocking readback of the whole
@@ -217,6 +218,9 @@ pub struct CaseResult {
     pub scene: String,
     pub bodies: usize,
     pub joints: usize,
+    /// The scene's relaxation iterations per substep and substeps per step.
+    pub iterations: u32,
+    pub substeps: u32,
     /// Why the case did not run (it does not fit the adapter), if it did not.
     pub skipped: Option<String>,
     /// A note on the case (run at a smaller size than named, and why).
@@ -229,7 +233,7 @@ pub struct CaseResult {
     pub startup_s: f64,
     /// Of which the first step (ms).
     pub first_step_ms: f64,
-    /// Median `World::with_gpu` of the repetitions (s), compiled pipelines cached.
+    /// Median `World::with_gpu` and untimed first step of the repetitions (s).
     pub setup_s: f64,
     pub ms_per_step: Vec<f64>,
     pub median_ms_per_step: f64,
@@ -749,7 +753,7 @@ fn render_cubes(gpu: &Arc<Gpu>) -> Result<(f64, f64), Error> {
 
 fn peer_description(opts: &Options, settings: &crate::Settings) -> (String, String) {
     let ours = format!(
-        "ours: {} Jacobi iterations x {} substeps = {} relaxation sweeps per step (defaults; the chain scene uses 8 substeps), \
+        "ours: {} Jacobi iterations x {} substeps = {} relaxation sweeps per step by default (each case's own in its row), \
          contacts found once per step",
         settings.iterations,
         settings.substeps,
@@ -786,6 +790,8 @@ fn blank(case: &Case, scene: &Scene, steps: u64, reps: usize) -> CaseResult {
         scene: case.scene.clone(),
         bodies: n,
         joints: scene.joints.len(),
+        iterations: scene.settings.iterations,
+        substeps: scene.settings.substeps,
         skipped: None,
         note: None,
         steps,
@@ -865,6 +871,9 @@ fn run_case(
     for r in 0..reps {
         let t = Instant::now();
         let mut world = World::with_gpu(gpu.clone(), &scene)?;
+        // lavapipe loads (or, with its shader cache off, compiles) a world's
+        // pipelines at their first dispatch: keep that out of the timing
+        world.step(1)?;
         gpu.wait()?;
         setups.push(t.elapsed().as_secs_f64());
         let t = Instant::now();
@@ -928,6 +937,7 @@ fn run_peer(case: &Case, scene: &Scene, steps: u64, reps: usize, ours_ms: f64, o
     for r in 0..reps {
         let t = Instant::now();
         let mut w = peer::RapierWorld::new(scene, opts.rapier_sleeping, opts.rapier_iterations);
+        w.step(1); // as ours: the first step untimed, the same steps timed
         setups.push(t.elapsed().as_secs_f64());
         let t = Instant::now();
         w.step(steps);
@@ -1169,14 +1179,16 @@ pub fn table(r: &Report) -> String {
     let _ = writeln!(s, "\nsanity (after the last repetition):\n");
     let _ = writeln!(
         s,
-        "| case | first step ms | set-up s (cached) | mean height m | rapier mean height m | max contacts/body | overflow | load avg start/end |"
+        "| case | iterations x substeps | first step ms | set-up + 1 step s (later worlds) | mean height m | rapier mean height m | max contacts/body | overflow | load avg start/end |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---|---:|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---|---:|");
     for c in r.cases.iter().filter(|c| c.skipped.is_none()) {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.2} | {:.3} | {} | {} | {} | {} |",
+            "| {} | {} x {} | {} | {:.2} | {:.3} | {} | {} | {} | {} |",
             c.case,
+            c.iterations,
+            c.substeps,
             fmt_ms(c.first_step_ms),
             c.setup_s,
             c.mean_height,
