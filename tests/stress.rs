@@ -13,6 +13,17 @@
 //! the GPU's buffers) against its level after the warm-up chunk, and the GPU
 //! memory the allocator reports (`Device::generate_allocator_report`, which
 //! wgpu 30 gives on Vulkan without extra features) against the same.
+//! wgpu's internal counters are printed too, but read zero unless its
+//! `counters` feature is on.
+//!
+//! Measured 2026-11-23 on lavapipe (llvmpipe, LLVM 15, 2 cores shared with
+//! other builds and a benchmark): STRESS_STEPS=1000 STRESS_CHUNK=100 passed
+//! in 1324 s (0.6 to 2.1 s per step by chunk, 1.3 mean); RSS 74 MB before
+//! the world, 119.1 MB after the first chunk, 119.3 MB at the end; GPU
+//! memory 7 662 568 bytes in 18 allocations after every chunk; no fault.
+//! The full 10 000 steps would take about 3 to 3.5 hours there. The pile's
+//! contact lists overflow (a body wanted up to 41 points, 24 fit) and its
+//! fastest body still moves 2 to 6 m/s after it has settled.
 
 mod common;
 
