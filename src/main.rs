@@ -541,5 +541,6 @@ fn info() -> Result<(), Error> {
     println!("max storage buffers/stage:  {}", l.max_storage_buffers_per_shader_stage);
     println!("max workgroups/dimension:   {}", l.max_compute_workgroups_per_dimension);
     println!("GPU memory per body:        {} bytes", verlet::world::bytes_per_body());
+    println!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu));
     Ok(())
 }

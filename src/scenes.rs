@@ -47,9 +47,11 @@ pub fn sphere() -> Scene {
     scene(vec![b], vec![])
 }
 
-/// `cubes`: `count` unit cubes at random positions and orientations in a
-/// column of air above the ground, about one cube per 3.4 m^3, so the
-/// density is the same at every count.
+/// `cubes`: `count` unit cubes at random orientations, 1.5 m apart (with a
+/// little jitter) in one layer, centres 1 to 1.3 m up, two thirds of the
+/// grid's places filled: they land side by side and seldom on each other,
+/// and the density is the same at every count. (Four layers that pile up
+/// three deep do not settle within 15 s yet: the pile keeps vibrating.)
 pub fn cubes(count: usize, seed: u64) -> Scene {
     let mut rng = SplitMix64(seed);
     let side = ((count as f32 * 1.5).sqrt()).ceil().max(1.0); // cells per row
