@@ -12,8 +12,8 @@ struct Snap {
     dtheta: vec3<f32>,
 }
 
-// The translations one partner's points ask for, kept apart until the
-// partner's last point so they can be scaled together (see `flush`).
+// What one partner's points ask for, kept apart until the partner's last
+// point so that it can be scaled and averaged as a whole (see `flush`).
 struct Manifold {
     normal_dx: vec3<f32>,   // summed translation of the normal snaps
     normal_inv_w: f32,      // sum over those points of 1 / (w_self + w_partner)
@@ -36,8 +36,9 @@ fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>
 // Static friction (as XPBD has it): if the two material points have slid
 // apart since their previous poses by less than mu times the normal push
 // summed over this substep, the slide is undone; a larger slide is left to
-// dynamic friction in the restitution pass. Returns the push (m).
-fn add_contact(acc: ptr<function, Snap>, m: ptr<function, Manifold>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
+// dynamic friction in the restitution pass. The snaps are added to the
+// partner's manifold `m`. Returns the push (m).
+fn add_contact(m: ptr<function, Manifold>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
     let o = partner_point(c);
     let n = c.normal;
     let r = quat_rotate(s.rot, c.local_self);
@@ -75,13 +76,15 @@ fn add_contact(acc: ptr<function, Snap>, m: ptr<function, Manifold>, s: BodyStat
     return push;
 }
 
-// Adds one partner's translations to the body's. Each point's snap moves the
-// body as if that point were alone; when several points of one face all ask
-// for the same depth d, their sum is d x (pair_w x the sum of 1/w), which
-// is d for points at the corners of a cube but four times d for points near
-// the middle of a large face (a box resting across two others): that
-// overshoot made piles vibrate and walk apart. The sum is scaled down to what
-// moving the two bodies apart without turning asks for, never up.
+// Adds one partner's snaps to the body's and empties `m`; returns 1 if the
+// partner pushed at all. Each point's snap moves the body as if that point
+// were alone; when several points of one face all ask for the same depth d,
+// their sum is d x (pair_w x the sum of 1/w), which is d for points at the
+// corners of a cube but four times d for points near the middle of a large
+// face (a box resting across two others): that overshoot made piles vibrate
+// and walk apart. The sum is scaled down to what moving the two bodies apart
+// without turning asks for, never up. The points' turns are averaged: each
+// was computed as if it alone turned the body.
 fn flush(acc: ptr<function, Snap>, m: ptr<function, Manifold>) -> u32 {
     let touched = u32((*m).points > 0u);
     let n_scale = min(1.0, 1.0 / max((*m).pair_w * (*m).normal_inv_w, 1e-30));
@@ -148,7 +151,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
             m.pair_w = m.pair_w + props[c.partner].inv_inertia.w;
         }
         let count_before = m.normal_inv_w + m.friction_inv_w;
-        let push = add_contact(&acc, &m, s, p, c);
+        let push = add_contact(&m, s, p, c);
         contacts[k].pushed = c.pushed + push;
         if (m.normal_inv_w + m.friction_inv_w != count_before) {
             m.points = m.points + 1u;
