@@ -166,18 +166,7 @@ pub struct Stages {
 impl Stages {
     fn from_times(t: &StageTimes, steps: u64) -> Stages {
         let get = |s: Stage| t.ms_per_step.iter().find(|(k, _)| *k == s).map_or(0.0, |x| x.1);
-        let broadphase = [
-            Stage::GridClear,
-            Stage::GridCount,
-            Stage::GridScanBlocks,
-            Stage::GridScanSums,
-            Stage::GridScanAdd,
-            Stage::GridScatter,
-            Stage::GridSort,
-        ]
-        .iter()
-        .map(|&s| get(s))
-        .sum::<f64>();
+        let broadphase = Stage::ALL.iter().filter(|s| s.is_broadphase()).map(|&s| get(s)).sum::<f64>();
         let (narrowphase, integrate, solve, restitution) =
             (get(Stage::Narrowphase), get(Stage::Integrate), get(Stage::Solve), get(Stage::Restitution));
         Stages {
@@ -488,31 +477,14 @@ impl CopyKernel {
             pass.dispatch_workgroups(groups, 1, 1);
         };
         if timestamps {
-            let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("copy_state"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2 * passes as u32,
-            });
-            let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("copy_state/resolve"),
-                size: 16 * passes as u64,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
+            let timer = crate::gpu::PassTimer::new(gpu, "copy_state", passes);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
-            for k in 0..passes as u32 {
-                let writes = wgpu::ComputePassTimestampWrites {
-                    query_set: &set,
-                    beginning_of_pass_write_index: Some(2 * k),
-                    end_of_pass_write_index: Some(2 * k + 1),
-                };
-                encode(&mut enc, Some(writes));
+            for k in 0..passes {
+                encode(&mut enc, Some(timer.writes(k)));
             }
-            enc.resolve_query_set(&set, 0..2 * passes as u32, &resolve, 0);
+            timer.resolve(&mut enc);
             gpu.queue.submit([enc.finish()]);
-            let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&gpu.read_buffer(&resolve, 16 * passes as u64)?);
-            let period_ms = gpu.queue.get_timestamp_period() as f64 * 1e-6;
-            Ok((0..passes).map(|k| ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period_ms).collect())
+            Ok(timer.read_ms(gpu)?)
         } else {
             let mut out = Vec::with_capacity(passes);
             for _ in 0..passes {

@@ -479,20 +479,7 @@ impl World {
         let mut totals = vec![0.0f64; Stage::ALL.len()];
         let gpu = self.gpu.clone();
         let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let queries = timestamps.then(|| {
-            let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("profile"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2 * passes as u32,
-            });
-            let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("profile/resolve"),
-                size: 16 * passes as u64,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            (set, resolve)
-        });
+        let timer = timestamps.then(|| crate::gpu::PassTimer::new(&gpu, "profile", passes));
         for _ in 0..steps {
             let dt = [self.settings.dt];
             self.write_params(&dt, substeps);
@@ -500,15 +487,8 @@ impl World {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             {
                 for &(stage, slot) in &plan {
-                    match &queries {
-                        Some((set, _)) => {
-                            let writes = wgpu::ComputePassTimestampWrites {
-                                query_set: set,
-                                beginning_of_pass_write_index: Some(2 * k as u32),
-                                end_of_pass_write_index: Some(2 * k as u32 + 1),
-                            };
-                            self.encode_pass(&mut encoder, stage, slot, Some(writes));
-                        }
+                    match &timer {
+                        Some(timer) => self.encode_pass(&mut encoder, stage, slot, Some(timer.writes(k))),
                         None => {
                             gpu.queue.submit([encoder.finish()]);
                             gpu.wait()?;
@@ -524,15 +504,13 @@ impl World {
                     k += 1;
                 }
             }
-            if let Some((set, resolve)) = &queries {
-                encoder.resolve_query_set(set, 0..2 * passes as u32, resolve, 0);
+            if let Some(timer) = &timer {
+                timer.resolve(&mut encoder);
             }
             gpu.queue.submit([encoder.finish()]);
-            if let Some((_, resolve)) = &queries {
-                let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&gpu.read_buffer(resolve, 16 * passes as u64)?);
-                let period_ms = gpu.queue.get_timestamp_period() as f64 * 1e-6;
-                for (k, (stage, _)) in plan.iter().enumerate() {
-                    totals[*stage as usize] += ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period_ms;
+            if let Some(timer) = &timer {
+                for ((stage, _), ms) in plan.iter().zip(timer.read_ms(&gpu)?) {
+                    totals[*stage as usize] += ms;
                 }
             }
             self.finish_steps(&dt, substeps);

@@ -196,3 +196,50 @@ impl Gpu {
         Ok(bytes)
     }
 }
+
+/// GPU timestamps around a run of compute passes: pass k writes queries 2k
+/// and 2k + 1, resolved at the end of the encoder and read back as ms.
+pub struct PassTimer {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    passes: u32,
+}
+
+impl PassTimer {
+    /// Needs `Features::TIMESTAMP_QUERY`.
+    pub fn new(gpu: &Gpu, label: &str, passes: usize) -> PassTimer {
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some(label),
+            ty: wgpu::QueryType::Timestamp,
+            count: 2 * passes as u32,
+        });
+        let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: 16 * passes as u64,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        PassTimer { set, resolve, passes: passes as u32 }
+    }
+
+    /// The timestamp writes of pass `k`.
+    pub fn writes(&self, k: usize) -> wgpu::ComputePassTimestampWrites<'_> {
+        wgpu::ComputePassTimestampWrites {
+            query_set: &self.set,
+            beginning_of_pass_write_index: Some(2 * k as u32),
+            end_of_pass_write_index: Some(2 * k as u32 + 1),
+        }
+    }
+
+    /// Resolves every pass's queries at the end of `encoder`.
+    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.resolve_query_set(&self.set, 0..2 * self.passes, &self.resolve, 0);
+    }
+
+    /// Each pass's duration (ms), once the encoder has been submitted.
+    pub fn read_ms(&self, gpu: &Gpu) -> Result<Vec<f64>, GpuError> {
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&gpu.read_buffer(&self.resolve, 16 * self.passes as u64)?);
+        let period_ms = gpu.queue.get_timestamp_period() as f64 * 1e-6;
+        Ok((0..self.passes as usize).map(|k| ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period_ms).collect())
+    }
+}

@@ -72,6 +72,11 @@ impl Stage {
         }
     }
 
+    /// Whether the stage is part of the grid broadphase (`grid_*`).
+    pub fn is_broadphase(self) -> bool {
+        self.name().starts_with("grid_")
+    }
+
     /// Whether the pass writes state_out (so the current state flips).
     pub fn flips_state(self) -> bool {
         matches!(self, Stage::Integrate | Stage::Solve | Stage::Restitution)
