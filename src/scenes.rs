@@ -51,7 +51,7 @@ pub fn sphere() -> Scene {
 /// little jitter) in one layer, centres 1 to 1.3 m up, two thirds of the
 /// grid's places filled: they land side by side and seldom on each other,
 /// and the density is the same at every count. (Four layers that pile up
-/// three deep do not settle within 15 s yet: the pile keeps vibrating.)
+/// three deep do not settle within 15 s yet: the pile keeps creeping.)
 pub fn cubes(count: usize, seed: u64) -> Scene {
     let mut rng = SplitMix64(seed);
     let side = ((count as f32 * 1.5).sqrt()).ceil().max(1.0); // cells per row
