@@ -38,8 +38,14 @@ struct WorldData {
     contact_count: wgpu::Buffer,
     /// `bind_groups[k]` reads `states[k]` and writes `states[1 - k]`.
     bind_groups: [wgpu::BindGroup; 2],
-    /// Every other buffer, kept alive for the bind groups.
-    _others: Vec<wgpu::Buffer>,
+    /// Shapes, masses and materials (written by the input kernel too).
+    props: wgpu::Buffer,
+    /// What the scene fixed at start-up: the bodies kept out of the grid and
+    /// the joint lists (the snapshot's scene hash reads them).
+    statics: [wgpu::Buffer; 3],
+    /// Working buffers of the passes (vel0 and the grid), kept alive for
+    /// the bind groups.
+    _scratch: Vec<wgpu::Buffer>,
 }
 
 /// The broadphase grid's shape, fixed at start-up from the bodies' sizes.
@@ -202,13 +208,8 @@ impl World {
         let device = &gpu.device;
         let count = n.max(1); // wgpu buffers may not be empty
 
-        let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &settings)).collect();
+        let (props, large, grid) = scene_props(scene);
         let states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &settings)).collect();
-        let radii: Vec<f32> = props.iter().map(|p| p.half_extents[3]).collect();
-        let (large, grid) = plan_grid(&radii);
-        for &i in &large {
-            props[i as usize].kind[2] = LARGE;
-        }
 
         let storage = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -286,8 +287,17 @@ impl World {
         };
         let bind_groups = [bind_group(0), bind_group(1)];
         gpu.check()?;
-        let others = vec![props_buf, vel0, cell_count, cell_start, block_sums, sorted, large_buf, joint_start, joint_refs];
-        let data = WorldData { states: state_bufs, params, status, contacts, contact_count, bind_groups, _others: others };
+        let data = WorldData {
+            states: state_bufs,
+            params,
+            status,
+            contacts,
+            contact_count,
+            bind_groups,
+            props: props_buf,
+            statics: [large_buf, joint_start, joint_refs],
+            _scratch: vec![vel0, cell_count, cell_start, block_sums, sorted],
+        };
         let substep_dt = settings.dt / settings.substeps as f32;
         Ok(World {
             gpu,
@@ -699,6 +709,18 @@ pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
         .iter()
         .map(|j| (anchor(j.bodies[0], j.anchors[0]) - anchor(j.bodies[1], j.anchors[1])).length() as f32)
         .collect()
+}
+
+/// Every body's GPU record, the bodies kept out of the grid (marked LARGE in
+/// their records) and the grid for the rest.
+pub fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
+    let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &scene.settings)).collect();
+    let radii: Vec<f32> = props.iter().map(|p| p.half_extents[3]).collect();
+    let (large, grid) = plan_grid(&radii);
+    for &i in &large {
+        props[i as usize].kind[2] = LARGE;
+    }
+    (props, large, grid)
 }
 
 /// The GPU record of a body's shape, mass and material.

@@ -5,7 +5,7 @@ mod common;
 
 use glam::Vec3;
 use verlet::scenes::{self, box_body, sphere_body};
-use verlet::world::{bytes_per_body, max_bodies};
+use verlet::world::max_bodies;
 use verlet::{Error, World};
 
 #[test]
@@ -24,7 +24,6 @@ fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
     }
     // nothing was allocated, so the device is still healthy
     gpu.check().unwrap();
-    assert!(bytes_per_body() > 0);
 }
 
 #[test]

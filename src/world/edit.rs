@@ -10,7 +10,7 @@
 
 use std::ops::Range;
 
-use super::World;
+use super::{initial_state, scene_props, World};
 use crate::gpu::types::{BodyProps, BodyState};
 use crate::scene::{Body, Joint};
 use crate::Error;
@@ -58,13 +58,12 @@ impl World {
     fn rebuild(&mut self, scene: crate::Scene, keep: &[Option<usize>]) -> Result<(), Error> {
         scene.validate()?;
         let old_states = self.read_raw()?;
-        let props_bytes = self.gpu.read_buffer(self.props_buffer(), (self.body_count().max(1) * size_of::<BodyProps>()) as u64)?;
+        let props_bytes = self.gpu.read_buffer(&self.data.props, (self.body_count().max(1) * size_of::<BodyProps>()) as u64)?;
         let old_props: Vec<BodyProps> = bytemuck::pod_collect_to_vec(&props_bytes);
         let mut world = World::with_gpu(self.gpu.clone(), &scene)?;
-        let fresh_bytes = world.gpu.read_buffer(world.props_buffer(), (world.body_count().max(1) * size_of::<BodyProps>()) as u64)?;
-        let mut props: Vec<BodyProps> = bytemuck::pod_collect_to_vec(&fresh_bytes);
-        props.truncate(world.body_count());
-        let mut states = world.read_raw()?;
+        // what with_gpu uploaded, then the kept bodies put back over it
+        let (mut props, _, _) = scene_props(&scene);
+        let mut states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &scene.settings)).collect();
         for (k, from) in keep.iter().enumerate() {
             if let Some(from) = *from {
                 states[k] = old_states[from];
@@ -77,18 +76,12 @@ impl World {
         }
         let queue = &world.gpu.queue;
         queue.write_buffer(&world.data.states[world.current], 0, bytemuck::cast_slice::<BodyState, u8>(&states));
-        queue.write_buffer(world.props_buffer(), 0, bytemuck::cast_slice::<BodyProps, u8>(&props));
+        queue.write_buffer(&world.data.props, 0, bytemuck::cast_slice::<BodyProps, u8>(&props));
         world.gpu.check()?;
         world.step = self.step;
         world.time = self.time;
         world.dt_prev = self.dt_prev;
         *self = world;
         Ok(())
-    }
-
-    /// The buffer of the bodies' shapes, masses and materials.
-    fn props_buffer(&self) -> &wgpu::Buffer {
-        // the first of `with_gpu`'s other buffers
-        &self.data._others[0]
     }
 }

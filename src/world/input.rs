@@ -446,8 +446,7 @@ impl World {
                 mapped_at_creation: false,
             })
         };
-        // the props buffer is the first of WorldData::_others (see World::with_gpu)
-        let props = &self.data._others[0];
+        let props = &self.data.props;
         debug_assert_eq!(props.size(), (self.body_count.max(1) as u64 * 64).max(64));
         let states = &self.data.states;
         let bind_groups = |layout: &wgpu::BindGroupLayout, header: &wgpu::Buffer, list: &wgpu::Buffer| {

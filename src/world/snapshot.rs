@@ -229,12 +229,8 @@ impl World {
         put(&self.grid.hash_size.to_le_bytes());
         put(&self.grid.speculative.to_bits().to_le_bytes());
         put(&self.large_count.to_le_bytes());
-        // `_others` holds, in this order: props, vel0, four grid buffers,
-        // the large list, joint starts, joint refs; the static ones are 0, 6, 7, 8.
-        for k in [0usize, 6, 7, 8] {
-            if let Some(buf) = self.data._others.get(k) {
-                put(&self.gpu.read_buffer(buf, buf.size())?);
-            }
+        for buf in std::iter::once(&self.data.props).chain(&self.data.statics) {
+            put(&self.gpu.read_buffer(buf, buf.size())?);
         }
         Ok(h)
     }
