@@ -5,8 +5,8 @@
 // Pose of one body: what swaps between the two state buffers every pass.
 // 64 bytes. Quaternions are (x, y, z, w).
 struct BodyState {
-    pos: vec4<f32>,      // xyz = centre of mass (m); w unused
-    prev_pos: vec4<f32>, // xyz = centre of mass one step ago
+    pos: vec4<f32>,      // xyz = centre of mass (m); w = seconds at rest (see `asleep`)
+    prev_pos: vec4<f32>, // xyz = centre of mass one step ago; w = 1 if a contact pushed it then
     rot: vec4<f32>,      // orientation, unit quaternion
     prev_rot: vec4<f32>, // orientation one step ago
 }
@@ -44,7 +44,11 @@ struct Params {
     speculative: f32,        // farthest gap (m) at which grid pairs get contacts
     substeps: u32,           // substeps per step: contacts found once serve them all
     step_index: u32,         // the world's step count as this step began (saturates at NO_FAULT - 1)
-    _pad2: u32,
+    sleep_after: f32,        // seconds at rest before a body sleeps; 0: never (settings.sleeping)
+    substep: u32,            // which substep of the step this is (0 first)
+    _pad3: u32,
+    _pad4: u32,
+    _pad5: u32,
 }
 
 // One contact point of a body, stored in the body's own slots: the point on
@@ -201,9 +205,31 @@ fn partner_point(c: Contact) -> PartnerPoint {
     return PartnerPoint(r, o.pos.xyz + r, o.prev_pos.xyz + quat_rotate(o.prev_rot, c.local_partner));
 }
 
-// The partner's generalised inverse mass along dir (0 for the ground).
+// Sleeping (settings.sleeping; the paper has none). A body that has been
+// slower than SLEEP_SPEED while touching something for params.sleep_after
+// seconds sleeps: integrate holds it still, without gravity, the solve and
+// restitution passes leave it as it is, and every awake body treats it as
+// fixed. It wakes when an awake body touching it moves faster than
+// WAKE_SPEED, and every body wakes after any user input or edit. BodyState
+// pos.w counts the seconds at rest. Bodies with joints never sleep.
+fn asleep(s: BodyState) -> bool {
+    return params.sleep_after > 0.0 && s.pos.w >= params.sleep_after;
+}
+
+const SLEEP_SPEED: f32 = 0.05; // m/s
+const WAKE_SPEED: f32 = 0.2;   // m/s
+
+// An upper bound of the speed of any point of a body over the last substep
+// (m/s): the centre's speed plus the spin times the bounding radius.
+fn point_speed(s: BodyState, p: BodyProps) -> f32 {
+    let spin = length(quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))));
+    return (length(s.pos.xyz - s.prev_pos.xyz) + spin * p.half_extents.w) / params.dt_prev;
+}
+
+// The partner's generalised inverse mass along dir (0 for the ground and for
+// a sleeping body).
 fn partner_inv_mass(c: Contact, r: vec3<f32>, dir: vec3<f32>) -> f32 {
-    if (c.partner == GROUND) {
+    if (c.partner == GROUND || asleep(state_in[c.partner])) {
         return 0.0;
     }
     return effective_inv_mass(props[c.partner], state_in[c.partner].rot, r, dir);

@@ -165,6 +165,16 @@ fn apply_inputs(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
+// Every body wakes after any input (see `asleep` in common.wgsl): dispatched
+// over all bodies after each input kernel.
+@compute @workgroup_size(WORKGROUP)
+fn wake_all(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i < input.counts.x && state_out[i].pos.w != 0.0) {
+        state_out[i].pos.w = 0.0;
+    }
+}
+
 // A radial impulse of input.centre.w (N s) on every dynamic body whose centre
 // lies within input.reach.x of input.centre.xyz, scaled by (1 - d / radius)
 // ^ falloff, along the direction from the centre to the body's centre (up

@@ -17,6 +17,30 @@
 // without the check. The host reads the flag only on request
 // (World::faults, World::read_state), never in the step loop.
 
+// Sleeping (see `asleep` in common.wgsl): a body sleeps once it has moved
+// slower than SLEEP_SPEED, at every point, for params.sleep_after seconds
+// while touching something (the solve leaves 1 in prev_pos.w when a contact
+// of the body pushed in the substep); a sleeper wakes when an awake body in
+// its contact list moves faster than WAKE_SPEED at any point; inputs and
+// edits wake every body (input.wgsl's wake_all). Box2D's rule is alike (it
+// sleeps whole islands; this sleeps bodies, and a body's awake partners
+// treat it as fixed).
+// Whether an awake body in i's contact list moves fast enough to wake it
+// (the narrowphase decided alike, and listed all of i's contacts then).
+fn nudged(i: u32) -> bool {
+    let first = i * MAX_CONTACTS;
+    for (var k = first; k < first + contact_count[i]; k = k + 1u) {
+        let j = contacts[k].partner;
+        if (j != GROUND) {
+            let o = state_in[j];
+            if (!asleep(o) && point_speed(o, props[j]) > WAKE_SPEED) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 // Beyond these a body is absurd (m, m/s).
 const MAX_DISTANCE: f32 = 1e6;
 const MAX_SPEED: f32 = 1e4;
@@ -110,6 +134,23 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
+    // seconds at rest, this substep included
+    var rest = 0.0;
+    if (params.sleep_after > 0.0) {
+        if (asleep(s)) {
+            if (params.substep != 0u || !nudged(i)) {
+                rest = s.pos.w;
+            }
+        } else if (s.prev_pos.w > 0.0 && joint_start[i] == joint_start[i + 1u] && point_speed(s, p) < SLEEP_SPEED) {
+            rest = s.pos.w + dt;
+        }
+    }
+    if (rest >= params.sleep_after && rest > 0.0) {
+        // asleep: held still where it is
+        state_out[i] = BodyState(vec4<f32>(s.pos.xyz, rest), s.pos, s.rot, s.rot);
+        vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
+        return;
+    }
     // eq. 11: the last displacement, rescaled to this step's length
     let ratio = dt / params.dt_prev;
     // eq. 12: damping keeps (1 - beta) of it
@@ -130,6 +171,6 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rot = normalize(quat_mul(turn, s.rot));
     let spin = quat_to_rotvec(turn);
 
-    state_out[i] = BodyState(vec4<f32>(pos, 0.0), s.pos, rot, s.rot);
+    state_out[i] = BodyState(vec4<f32>(pos, rest), s.pos, rot, s.rot);
     vel0[i] = Velocity(vec4<f32>((pos - s.pos.xyz) / dt, 0.0), vec4<f32>(spin / dt, 0.0));
 }

@@ -14,6 +14,15 @@ const CONTACT_MARGIN: f32 = 0.02;
 var<private> self_index: u32;
 var<private> self_count: u32;
 var<private> wanted: u32;
+// A sleeping body lists only its contacts with awake bodies (pairs of
+// sleepers and a sleeper's ground contacts are skipped: neither moves)
+// unless one of those awake bodies moves fast enough to wake it (`nudged`);
+// then it lists all of them again, since it wakes in this step's first
+// substep (integrate's `nudged` decides alike from that list).
+var<private> awake_only: bool;
+var<private> nudged_by: bool;
+// separation of each kept contact (m; negative: overlap)
+var<private> kept_gap: array<f32, MAX_CONTACTS>;
 
 fn shape_of(i: u32) -> Shape {
     let s = state_in[i];
@@ -31,12 +40,27 @@ fn reach_of(i: u32) -> f32 {
     return length(s.pos.xyz - s.prev_pos.xyz) * ratio + length(params.gravity.xyz) * h * h;
 }
 
-fn add_contact(c: Contact) {
+// Keeps contact c, whose points are `gap` apart along the normal. A full
+// list keeps the closest points: c replaces the kept contact with the widest
+// gap if its own is narrower (speculative points go first, touching ones
+// stay), and the overflow is reported through `wanted`.
+fn add_contact(c: Contact, gap: f32) {
     wanted = wanted + 1u;
+    var slot = self_count;
     if (self_count < MAX_CONTACTS) {
-        contacts[self_index * MAX_CONTACTS + self_count] = c;
         self_count = self_count + 1u;
+    } else {
+        for (var k = 0u; k < MAX_CONTACTS; k = k + 1u) {
+            if (kept_gap[k] > gap && (slot == MAX_CONTACTS || kept_gap[k] > kept_gap[slot])) {
+                slot = k;
+            }
+        }
+        if (slot == MAX_CONTACTS) {
+            return;
+        }
     }
+    kept_gap[slot] = gap;
+    contacts[self_index * MAX_CONTACTS + slot] = c;
 }
 
 // A box's corners, or a sphere's lowest point, within the margin of the ground.
@@ -55,7 +79,7 @@ fn ground_contacts(i: u32, margin: f32) {
         let lowest = s.pos.xyz - vec3<f32>(0.0, p.half_extents.x, 0.0);
         c.local_self = quat_rotate(quat_conj(s.rot), lowest - s.pos.xyz);
         c.local_partner = vec3<f32>(lowest.x, ground, lowest.z);
-        add_contact(c);
+        add_contact(c, lowest.y - ground);
         return;
     }
     for (var k = 0u; k < 8u; k = k + 1u) {
@@ -68,7 +92,7 @@ fn ground_contacts(i: u32, margin: f32) {
         if (w.y - ground <= margin) {
             c.local_self = corner;
             c.local_partner = vec3<f32>(w.x, ground, w.z);
-            add_contact(c);
+            add_contact(c, w.y - ground);
         }
     }
 }
@@ -107,7 +131,14 @@ fn consider(j: u32) {
     if (gap > margin) {
         return;
     }
+    let j_asleep = asleep(state_in[j]);
+    if (awake_only && (j_asleep || is_fixed(pj))) {
+        return;
+    }
     let m = collide(shape_of(lo), shape_of(hi), margin);
+    if (m.count > 0u && !j_asleep && point_speed(state_in[j], pj) > WAKE_SPEED) {
+        nudged_by = true;
+    }
     for (var k = 0u; k < m.count; k = k + 1u) {
         var c: Contact;
         c.partner = j;
@@ -121,7 +152,7 @@ fn consider(j: u32) {
             c.local_partner = world_to_local(j, m.on_a[k]);
             c.normal = m.normal;
         }
-        add_contact(c);
+        add_contact(c, dot(m.on_b[k] - m.on_a[k], m.normal));
     }
 }
 
@@ -141,6 +172,34 @@ fn consider_cell(c: vec3<i32>) {
 // only meets the bodies of the cells nearest its centre.
 const MAX_SCAN_CELLS: i32 = 32;
 
+// Lists body i's contacts: the ground's, then its grid neighbours' and the
+// large bodies'.
+fn gather(i: u32) {
+    let p = props[i];
+    let my_reach = reach_of(i);
+    if (params.has_ground != 0u && !awake_only) {
+        ground_contacts(i, CONTACT_MARGIN + my_reach);
+    }
+    let centre = state_in[i].pos.xyz;
+    var lo = cell_of(centre) - vec3<i32>(1);
+    var hi = cell_of(centre) + vec3<i32>(1);
+    if (!in_grid(i)) {
+        let r = vec3<f32>(p.half_extents.w + my_reach + params.speculative);
+        lo = max(cell_of(centre - r), cell_of(centre) - vec3<i32>(MAX_SCAN_CELLS));
+        hi = min(cell_of(centre + r), cell_of(centre) + vec3<i32>(MAX_SCAN_CELLS));
+    }
+    for (var x = lo.x; x <= hi.x; x = x + 1) {
+        for (var y = lo.y; y <= hi.y; y = y + 1) {
+            for (var z = lo.z; z <= hi.z; z = z + 1) {
+                consider_cell(vec3<i32>(x, y, z));
+            }
+        }
+    }
+    for (var k = 0u; k < params.large_count; k = k + 1u) {
+        consider(large[k]);
+    }
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -150,30 +209,16 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     self_index = i;
     self_count = 0u;
     wanted = 0u;
-    let p = props[i];
     // fixed bodies keep no contacts: they never move
-    if (!is_fixed(p)) {
-        let my_reach = reach_of(i);
-        if (params.has_ground != 0u) {
-            ground_contacts(i, CONTACT_MARGIN + my_reach);
-        }
-        let centre = state_in[i].pos.xyz;
-        var lo = cell_of(centre) - vec3<i32>(1);
-        var hi = cell_of(centre) + vec3<i32>(1);
-        if (!in_grid(i)) {
-            let r = vec3<f32>(p.half_extents.w + my_reach + params.speculative);
-            lo = max(cell_of(centre - r), cell_of(centre) - vec3<i32>(MAX_SCAN_CELLS));
-            hi = min(cell_of(centre + r), cell_of(centre) + vec3<i32>(MAX_SCAN_CELLS));
-        }
-        for (var x = lo.x; x <= hi.x; x = x + 1) {
-            for (var y = lo.y; y <= hi.y; y = y + 1) {
-                for (var z = lo.z; z <= hi.z; z = z + 1) {
-                    consider_cell(vec3<i32>(x, y, z));
-                }
-            }
-        }
-        for (var k = 0u; k < params.large_count; k = k + 1u) {
-            consider(large[k]);
+    if (!is_fixed(props[i])) {
+        awake_only = asleep(state_in[i]);
+        nudged_by = false;
+        gather(i);
+        if (awake_only && nudged_by) {
+            awake_only = false;
+            self_count = 0u;
+            wanted = 0u;
+            gather(i);
         }
     }
     contact_count[i] = self_count;

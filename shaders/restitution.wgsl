@@ -34,7 +34,7 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state_in[i];
     let p = props[i];
     let count = contact_count[i];
-    if (is_fixed(p) || count == 0u) {
+    if (is_fixed(p) || count == 0u || asleep(s)) {
         state_out[i] = s;
         return;
     }
@@ -93,7 +93,7 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (any(dv != vec3<f32>(0.0)) || any(dw != vec3<f32>(0.0))) {
         let v = now.linear.xyz + dv;
         let w = now.angular.xyz + dw;
-        s.prev_pos = vec4<f32>(s.pos.xyz - v * params.dt, 0.0);
+        s.prev_pos = vec4<f32>(s.pos.xyz - v * params.dt, s.prev_pos.w);
         s.prev_rot = normalize(quat_mul(quat_from_rotvec(-w * params.dt), s.rot));
     }
     state_out[i] = s;

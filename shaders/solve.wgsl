@@ -128,7 +128,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var s = state_in[i];
     let p = props[i];
-    if (is_fixed(p)) {
+    if (is_fixed(p) || asleep(s)) {
         state_out[i] = s;
         return;
     }
@@ -136,6 +136,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let first = i * MAX_CONTACTS;
     let count = contact_count[i];
     var touching = 0u;
+    // 1 if a contact pushed in this substep: integrate's test for sleeping
+    var pressed = 0.0;
     // a partner's points are listed together (the narrowphase writes one
     // manifold per pair)
     var m = Manifold(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
@@ -147,12 +149,15 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
             partner = c.partner;
         }
         m.pair_w = p.inv_inertia.w;
-        if (c.partner != GROUND) {
+        if (c.partner != GROUND && !asleep(state_in[c.partner])) {
             m.pair_w = m.pair_w + props[c.partner].inv_inertia.w;
         }
         let count_before = m.normal_inv_w + m.friction_inv_w;
         let push = add_contact(&m, s, p, c);
         contacts[k].pushed = c.pushed + push;
+        if (c.pushed + push > 0.0) {
+            pressed = 1.0;
+        }
         if (m.normal_inv_w + m.friction_inv_w != count_before) {
             m.points = m.points + 1u;
         }
@@ -169,7 +174,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the partners' turns are averaged too (mass splitting, for the inertia
     // only: translations are scaled per partner in `flush`).
     let split = 1.0 / f32(max(touching, 1u));
-    s.pos = vec4<f32>(s.pos.xyz + acc.dx * params.relaxation, 0.0);
+    s.pos = vec4<f32>(s.pos.xyz + acc.dx * params.relaxation, s.pos.w);
+    s.prev_pos.w = pressed;
     s.rot = quat_add_rotation(s.rot, acc.dtheta * (params.relaxation * split));
     state_out[i] = s;
 }

@@ -137,7 +137,8 @@ pub struct Options {
     pub no_peer: bool,
     /// The peer only for cases of at most this many bodies.
     pub peer_max_bodies: Option<usize>,
-    /// Let rapier's bodies sleep (off by default: our bodies never sleep).
+    /// Let bodies sleep, ours and rapier's (off by default in the bench, so
+    /// that every body is simulated every step in both).
     pub rapier_sleeping: bool,
     /// rapier's `num_solver_iterations`; `None`: rapier's default (4).
     pub rapier_iterations: Option<usize>,
@@ -819,6 +820,8 @@ fn run_case(
         case.name = format!("cubes-max ({n})");
         scene = case.scene();
     }
+    // both engines sleep, or neither (the peer's default: off)
+    scene.settings.sleeping = opts.rapier_sleeping;
     let n = scene.bodies.len();
     let steps = steps.min((body_steps / n.max(1) as u64).max(MIN_STEPS));
     let profile_steps = profile_steps.min((body_steps / 10 / n.max(1) as u64).max(3));

@@ -78,7 +78,7 @@ struct BenchArgs {
     /// Run the peer only for cases of at most this many bodies.
     #[arg(long)]
     peer_max_bodies: Option<usize>,
-    /// Let rapier's bodies sleep (off by default: ours never do).
+    /// Let bodies sleep, ours and rapier's (off by default in the bench).
     #[arg(long)]
     rapier_sleeping: bool,
     /// rapier's num_solver_iterations (default: rapier's own, 4).

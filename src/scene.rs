@@ -102,7 +102,16 @@ pub struct Settings {
     /// Substeps per step (extension to the contract): each step of `dt` is
     /// taken as `substeps` steps of `dt / substeps`. 1..=64, default 3.
     pub substeps: u32,
+    /// Whether bodies at rest sleep (extension to the contract), default
+    /// true: a body slower than 5 cm/s at every point for `SLEEP_AFTER`
+    /// seconds while touching something is held still until an awake body
+    /// touching it moves faster than 20 cm/s, or any input or edit wakes
+    /// all. The paper has no sleeping and lists that as a weakness.
+    pub sleeping: bool,
 }
+
+/// Seconds at rest before a body sleeps (Box2D's time to sleep).
+pub const SLEEP_AFTER: f32 = 0.5;
 
 impl Default for Settings {
     /// The values shown in `INTERFACE.md`:
@@ -135,6 +144,7 @@ impl Default for Settings {
             restitution: 0.2,
             friction: 0.5,
             substeps: 3,
+            sleeping: true,
         }
     }
 }
@@ -551,6 +561,7 @@ struct RawSettings {
     restitution: Option<f32>,
     friction: Option<f32>,
     substeps: Option<u32>,
+    sleeping: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -658,6 +669,7 @@ impl RawSettings {
             restitution: self.restitution.unwrap_or(d.restitution),
             friction: self.friction.unwrap_or(d.friction),
             substeps: self.substeps.unwrap_or(d.substeps),
+            sleeping: self.sleeping.unwrap_or(d.sleeping),
         })
     }
 }
@@ -1182,6 +1194,7 @@ fn settings_json(s: &Settings) -> String {
         ("friction", num(s.friction)),
     ];
     fields.push(("substeps", s.substeps.to_string()));
+    fields.push(("sleeping", s.sleeping.to_string()));
     object_json(&fields, 1)
 }
 

@@ -27,6 +27,9 @@ pub struct BodyOutput {
     pub linear_velocity: [f32; 3],
     /// World frame (rad/s).
     pub angular_velocity: [f32; 3],
+    /// Whether the body sleeps (`Settings::sleeping`): held still until
+    /// something moving touches it or an input wakes it.
+    pub asleep: bool,
 }
 
 /// The GPU buffers of a world. Nothing here is created after start-up.
@@ -387,7 +390,7 @@ impl World {
             let h = dt / substeps as f32;
             // NO_FAULT is reserved: the step index saturates just below it
             let step_index = (self.step + k as u64).min(NO_FAULT as u64 - 1) as u32;
-            for _ in 0..substeps {
+            for substep in 0..substeps {
                 let p = Params {
                     gravity: [s.gravity[0], s.gravity[1], s.gravity[2], self.ground.unwrap_or(0.0)],
                     dt: h,
@@ -406,6 +409,8 @@ impl World {
                     speculative: self.grid.speculative,
                     substeps: substeps as u32,
                     step_index,
+                    sleep_after: if s.sleeping { crate::scene::SLEEP_AFTER } else { 0.0 },
+                    substep: substep as u32,
                     ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;
@@ -663,6 +668,7 @@ pub fn body_output(s: &BodyState, dt: f64) -> BodyOutput {
         orientation: s.rot,
         linear_velocity: v.as_vec3().to_array(),
         angular_velocity: w.as_vec3().to_array(),
+        asleep: s.pos[3] >= crate::scene::SLEEP_AFTER,
     }
 }
 

@@ -50,6 +50,11 @@ pub struct Gpu {
     /// Why the device was lost, once wgpu has said so (it calls the
     /// device-lost callback while polling).
     lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// Held while polling: wgpu-core 30.0.1 can panic when two threads poll
+    /// one device at once (an assertion in `Device::maintain` races; fixed
+    /// upstream in gfx-rs/wgpu#9958). Threads that share a `Gpu` (the tests
+    /// do) poll one at a time.
+    polling: std::sync::Mutex<()>,
 }
 
 impl fmt::Debug for Gpu {
@@ -127,7 +132,7 @@ impl Gpu {
                 first.get_or_insert_with(|| if message.trim().is_empty() { reason.to_string() } else { format!("{reason}: {message}") });
             }
         });
-        Ok(Gpu { adapter, device, queue, info, limits, errors, lost })
+        Ok(Gpu { adapter, device, queue, info, limits, errors, lost, polling: std::sync::Mutex::new(()) })
     }
 
     /// One line naming the adapter, its backend and driver.
@@ -142,7 +147,11 @@ impl Gpu {
         let started = std::time::Instant::now();
         loop {
             let slice = wgpu::PollType::Wait { submission_index: None, timeout: Some(WAIT_SLICE) };
-            match self.device.poll(slice) {
+            let polled = {
+                let _one_at_a_time = self.polling.lock().unwrap_or_else(|e| e.into_inner());
+                self.device.poll(slice)
+            };
+            match polled {
                 Ok(_) => break,
                 Err(wgpu::PollError::Timeout) => {
                     self.check()?;

@@ -40,7 +40,7 @@ pub struct Velocity {
     pub angular: [f32; 4],
 }
 
-/// Per-step parameters (80 bytes, stored in 256-byte slots).
+/// Per-step parameters (96 bytes, stored in 256-byte slots).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Params {
@@ -68,7 +68,13 @@ pub struct Params {
     /// The world's step count as this step began (saturating at
     /// `u32::MAX - 1`): the step a numerical fault is reported at.
     pub step_index: u32,
-    pub _pad2: u32,
+    /// Seconds at rest before a body sleeps; 0 when `settings.sleeping` is off.
+    pub sleep_after: f32,
+    /// Which substep of the step this is (0 first): sleepers wake only at 0.
+    pub substep: u32,
+    pub _pad3: u32,
+    pub _pad4: u32,
+    pub _pad5: u32,
 }
 
 /// One contact point held by a body (48 bytes); see `Contact` in common.wgsl.

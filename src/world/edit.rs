@@ -67,6 +67,8 @@ impl World {
         for (k, from) in keep.iter().enumerate() {
             if let Some(from) = *from {
                 states[k] = old_states[from];
+                // an edit wakes every body (see `asleep` in common.wgsl)
+                states[k].pos[3] = 0.0;
                 // mass, material and the fixed flag as the user last set them;
                 // whether it sits in the grid is the new world's choice
                 let large = props[k].kind[2];

@@ -38,12 +38,13 @@ use crate::Error;
 pub const INPUT: &str = include_str!("../../shaders/input.wgsl");
 
 /// Entry points of the input module.
-pub const ENTRY_POINTS: [&str; 3] = ["apply_inputs", "explode", "wind"];
+pub const ENTRY_POINTS: [&str; 4] = ["apply_inputs", "explode", "wind", "wake_all"];
 
 /// Indices into `ENTRY_POINTS` and `InputGpu::pipelines`.
 const APPLY: usize = 0;
 const EXPLODE: usize = 1;
 const WIND: usize = 2;
+const WAKE_ALL: usize = 3;
 
 /// The assembled WGSL module: common.wgsl, bindings.wgsl (only for the
 /// declarations common.wgsl's helpers name; none of them is bound), input.wgsl.
@@ -192,7 +193,7 @@ const BIND_PROPS: u32 = 18;
 pub(super) struct InputGpu {
     layout: wgpu::BindGroupLayout,
     /// One per entry point, in the order of `ENTRY_POINTS`.
-    pipelines: [wgpu::ComputePipeline; 3],
+    pipelines: [wgpu::ComputePipeline; ENTRY_POINTS.len()],
     header: wgpu::Buffer,
     ops: wgpu::Buffer,
     /// Ops `ops` holds.
@@ -427,6 +428,16 @@ impl World {
             pass.set_pipeline(&input.pipelines[kernel]);
             pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
             pass.dispatch_workgroups((threads as u32).div_ceil(WORKGROUP).max(1), 1, 1);
+        }
+        {
+            // any input wakes every body
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(ENTRY_POINTS[WAKE_ALL]),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&input.pipelines[WAKE_ALL]);
+            pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
+            pass.dispatch_workgroups(self.body_count.div_ceil(WORKGROUP).max(1), 1, 1);
         }
         gpu.queue.submit([encoder.finish()]);
         gpu.check()?;

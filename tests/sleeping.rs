@@ -1,0 +1,104 @@
+//! Sleeping (`settings.sleeping`, an extension, on by default): a body that
+//! has been slower than 5 cm/s at every point for half a second while
+//! touching something is held still; it wakes when an awake body touching it
+//! moves faster than 20 cm/s, and every body wakes after any input or edit.
+//! Bodies with joints never sleep; free-flying bodies never sleep.
+
+mod common;
+
+use common::{v3, world};
+use verlet::scene::{Joint, WORLD};
+use verlet::scenes::{self, box_body, sphere_body};
+
+#[test]
+fn a_box_at_rest_falls_asleep_and_then_does_not_move_at_all() {
+    let scene = scenes::drop();
+    let Some(mut w) = world(&scene) else { return };
+    w.step(180).unwrap(); // 3 s: landed at about 0.8 s
+    let a = w.read_state().unwrap()[0];
+    assert!(a.asleep, "a box lying still on the ground for 2 s is awake: {a:?}");
+    w.step(600).unwrap();
+    let b = w.read_state().unwrap()[0];
+    assert!(b.asleep);
+    assert_eq!((a.position, a.orientation), (b.position, b.orientation), "a sleeping box moved");
+    assert_eq!(b.linear_velocity, [0.0; 3]);
+    assert_eq!(b.angular_velocity, [0.0; 3]);
+    assert!((b.position[1] - 0.5).abs() < 0.005, "it sleeps at y = {} (resting: 0.5)", b.position[1]);
+}
+
+#[test]
+fn with_sleeping_off_no_body_sleeps() {
+    let mut scene = scenes::drop();
+    scene.settings.sleeping = false;
+    let Some(mut w) = world(&scene) else { return };
+    w.step(180).unwrap();
+    assert!(w.read_raw().unwrap().iter().all(|s| s.pos[3] == 0.0), "seconds at rest were counted with sleeping off");
+    assert!(!w.read_state().unwrap()[0].asleep);
+}
+
+#[test]
+fn a_slow_body_in_free_flight_never_sleeps() {
+    // no gravity, nothing to touch: 1 cm/s for 3 s is 3 cm, asleep or not
+    let mut scene = scenes::stack(0);
+    scene.settings.gravity = [0.0; 3];
+    let mut b = box_body([0.5; 3], [0.0, 5.0, 0.0]);
+    b.linear_velocity = [0.01, 0.0, 0.0];
+    scene.bodies = vec![b];
+    let Some(mut w) = world(&scene) else { return };
+    w.step(180).unwrap();
+    let s = w.read_state().unwrap()[0];
+    assert!(!s.asleep);
+    assert!((s.position[0] - 0.03).abs() < 1e-4, "drifted to x = {} (3 cm expected)", s.position[0]);
+}
+
+#[test]
+fn an_impulse_wakes_a_sleeping_box() {
+    let scene = scenes::drop();
+    let Some(mut w) = world(&scene) else { return };
+    w.step(180).unwrap();
+    assert!(w.read_state().unwrap()[0].asleep);
+    // 1000 kg: 2000 N s is 2 m/s along x
+    w.apply_impulse(0, [2000.0, 0.0, 0.0], None).unwrap();
+    assert!(!w.read_state().unwrap()[0].asleep, "the input did not wake the box");
+    w.step(1).unwrap();
+    let s = w.read_state().unwrap()[0];
+    assert!(!s.asleep);
+    // friction (mu 0.5 with the ground) takes mu g dt = 0.08 m/s per step
+    assert!((s.linear_velocity[0] - 2.0).abs() < 0.15, "after the impulse and a step: {:?}", s.linear_velocity);
+}
+
+#[test]
+fn a_falling_ball_wakes_a_sleeping_box_and_comes_to_rest_on_it() {
+    let mut scene = scenes::stack(1); // a unit box resting on the ground
+    let ball = sphere_body(0.25, [0.0, 12.0, 0.0]); // lands at about 1.5 s, at 14 m/s
+    scene.bodies.push(ball);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(80).unwrap();
+    let before = w.read_state().unwrap();
+    assert!(before[0].asleep, "the box should sleep before the ball arrives: {:?}", before[0]);
+    assert!(!before[1].asleep);
+    let mut box_woke = false;
+    for _ in 0..40 {
+        w.step(1).unwrap();
+        box_woke |= !w.read_state().unwrap()[0].asleep;
+    }
+    assert!(box_woke, "the ball's impact did not wake the box");
+    w.step(300).unwrap();
+    let after = w.read_state().unwrap();
+    assert!((after[1].position[1] - 1.25).abs() < 0.02, "the ball is at y = {} (on the box: 1.25)", after[1].position[1]);
+    assert!((after[0].position[1] - 0.5).abs() < 0.01, "the box is at y = {}", after[0].position[1]);
+    assert!(after[0].asleep && after[1].asleep, "both should sleep again: {after:?}");
+}
+
+#[test]
+fn a_body_with_a_joint_never_sleeps() {
+    // a box lying on the ground, held by a ball joint at a top corner: at rest
+    // and touching, it would sleep but for the joint
+    let mut scene = scenes::stack(1);
+    scene.joints = vec![Joint { bodies: [0, WORLD], anchors: [[0.5, 0.5, 0.5], [0.5, 1.0, 0.5]] }];
+    let Some(mut w) = world(&scene) else { return };
+    w.step(120).unwrap();
+    let s = w.read_state().unwrap()[0];
+    assert!(v3(s.position).distance(glam::Vec3::new(0.0, 0.5, 0.0)) < 0.01, "{s:?}");
+    assert!(!s.asleep, "a jointed body fell asleep");
+}
