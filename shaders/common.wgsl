@@ -61,7 +61,7 @@ struct Contact {
     local_partner: vec3<f32>,
     pushed: f32,             // normal push summed over this step's iterations (m): the friction budget
     normal: vec3<f32>,       // unit, world frame, pointing from the partner to this body
-    _pad1: u32,
+    gap: f32,                // separation of the two points when found (m; negative: overlap)
 }
 
 // Contact points a body can hold per step (a full list is reported, never

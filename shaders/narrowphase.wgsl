@@ -21,8 +21,6 @@ var<private> wanted: u32;
 // substep (integrate's `nudged` decides alike from that list).
 var<private> awake_only: bool;
 var<private> nudged_by: bool;
-// separation of each kept contact (m; negative: overlap)
-var<private> kept_gap: array<f32, MAX_CONTACTS>;
 
 fn shape_of(i: u32) -> Shape {
     let s = state_in[i];
@@ -44,23 +42,30 @@ fn reach_of(i: u32) -> f32 {
 // list keeps the closest points: c replaces the kept contact with the widest
 // gap if its own is narrower (speculative points go first, touching ones
 // stay), and the overflow is reported through `wanted`.
-fn add_contact(c: Contact, gap: f32) {
+// (The gaps are read back from the list itself: a private array of them
+// made this pass twice as slow on lavapipe.)
+fn add_contact(c_in: Contact, gap: f32) {
     wanted = wanted + 1u;
-    var slot = self_count;
+    var c = c_in;
+    c.gap = gap;
+    let first = self_index * MAX_CONTACTS;
     if (self_count < MAX_CONTACTS) {
+        contacts[first + self_count] = c;
         self_count = self_count + 1u;
-    } else {
-        for (var k = 0u; k < MAX_CONTACTS; k = k + 1u) {
-            if (kept_gap[k] > gap && (slot == MAX_CONTACTS || kept_gap[k] > kept_gap[slot])) {
-                slot = k;
-            }
-        }
-        if (slot == MAX_CONTACTS) {
-            return;
+        return;
+    }
+    var widest = gap;
+    var slot = MAX_CONTACTS;
+    for (var k = 0u; k < MAX_CONTACTS; k = k + 1u) {
+        let g = contacts[first + k].gap;
+        if (g > widest) {
+            widest = g;
+            slot = k;
         }
     }
-    kept_gap[slot] = gap;
-    contacts[self_index * MAX_CONTACTS + slot] = c;
+    if (slot < MAX_CONTACTS) {
+        contacts[first + slot] = c;
+    }
 }
 
 // A box's corners, or a sphere's lowest point, within the margin of the ground.
@@ -213,12 +218,16 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (!is_fixed(props[i])) {
         awake_only = asleep(state_in[i]);
         nudged_by = false;
-        gather(i);
-        if (awake_only && nudged_by) {
+        // one call site (a second would inline the whole pair test again,
+        // and lavapipe's compile time grows steeply with kernel size)
+        loop {
+            gather(i);
+            if (!(awake_only && nudged_by)) {
+                break;
+            }
             awake_only = false;
             self_count = 0u;
             wanted = 0u;
-            gather(i);
         }
     }
     contact_count[i] = self_count;

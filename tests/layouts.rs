@@ -44,7 +44,7 @@ fn shared_structs_match_member_by_member() {
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });
-    check_layout!(common, Contact { local_self, partner, local_partner, pushed, normal, _pad1 });
+    check_layout!(common, Contact { local_self, partner, local_partner, pushed, normal, gap });
 }
 
 #[test]

@@ -11,13 +11,18 @@ fn bodies_spawned_into_a_running_pile_settle_with_the_rest() {
     let scene = scenes::cubes(100, 4);
     let Some(mut w) = world(&scene) else { return };
     w.step(180).unwrap();
-    let before = w.read_raw().unwrap();
+    let mut before = w.read_raw().unwrap();
+    assert!(before.iter().any(|s| s.pos[3] > 0.0), "no body at rest after 3 s");
+    // an edit wakes every body: its seconds at rest (pos.w) start again
+    for s in &mut before {
+        s.pos[3] = 0.0;
+    }
     let spawned: Vec<_> = (0..10).map(|k| box_body([0.5; 3], [k as f32 * 1.2 - 6.0, 8.0, 0.3 * k as f32])).collect();
     let range = w.add_bodies(&spawned, &[]).unwrap();
     assert_eq!(range, 100..110);
     assert_eq!(w.body_count(), 110);
     assert_eq!(w.step_count(), 180);
-    // the bodies that were there are carried over bit for bit
+    // the bodies that were there are carried over bit for bit, awake
     let after = w.read_raw().unwrap();
     assert!(bytemuck::cast_slice::<_, u8>(&before) == bytemuck::cast_slice::<_, u8>(&after[..100]), "adding moved the pile");
     w.step(600).unwrap();

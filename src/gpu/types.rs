@@ -89,7 +89,9 @@ pub struct Contact {
     /// Normal push summed over the step's iterations (m): the friction budget.
     pub pushed: f32,
     pub normal: [f32; 3],
-    pub _pad1: u32,
+    /// Separation of the two points when the narrowphase found them (m;
+    /// negative: overlap); a full list keeps the smallest.
+    pub gap: f32,
 }
 
 /// One end of a ball joint as the body at that end sees it (32 bytes): its
