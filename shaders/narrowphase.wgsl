@@ -177,6 +177,22 @@ fn consider_cell(c: vec3<i32>) {
 // only meets the bodies of the cells nearest its centre.
 const MAX_SCAN_CELLS: i32 = 32;
 
+// After replacements in a full list a partner's points may lie apart; the
+// solve wants each partner's points together (one manifold), so a full list
+// is sorted by partner (insertion sort: stable, and only for full lists).
+fn regroup(i: u32) {
+    let first = i * MAX_CONTACTS;
+    for (var k = 1u; k < MAX_CONTACTS; k = k + 1u) {
+        let c = contacts[first + k];
+        var j = k;
+        while (j > 0u && contacts[first + j - 1u].partner > c.partner) {
+            contacts[first + j] = contacts[first + j - 1u];
+            j = j - 1u;
+        }
+        contacts[first + j] = c;
+    }
+}
+
 // Lists body i's contacts: the ground's, then its grid neighbours' and the
 // large bodies'.
 fn gather(i: u32) {
@@ -229,6 +245,9 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
             self_count = 0u;
             wanted = 0u;
         }
+    }
+    if (wanted > MAX_CONTACTS) {
+        regroup(i);
     }
     contact_count[i] = self_count;
     atomicMax(&status[0], wanted);

@@ -133,6 +133,10 @@ impl Default for Settings {
     /// - dampings 0: no energy is removed unless a scene asks for it.
     /// - `restitution` 0.2: contacts bounce a little, as wood or plastic do.
     /// - `friction` 0.5: a common everyday value (wood on wood).
+    /// - `sleeping` on: Jacobi sweeps converge slowly through a pile several
+    ///   bodies deep, and what they leave over creeps (1000 cubes dropped
+    ///   in four layers: a quarter still move 1 cm a second after 15 s with
+    ///   sleeping off, none with it on). Box2D, rapier and PhysX sleep too.
     fn default() -> Self {
         Settings {
             dt: 1.0 / 60.0,

@@ -40,7 +40,7 @@ const ROOTS: &[&str] = &["scene", "settings", "ground", "bodies", "joints", "cam
 /// Names and tokens that steer mutations towards what the loader knows.
 const KEYS: &[&str] = &[
     "settings", "dt", "gravity", "iterations", "relaxation", "linear_damping", "angular_damping", "restitution",
-    "friction", "substeps", "ground", "height", "bodies", "shape", "type", "box", "sphere", "half_extents", "radius",
+    "friction", "substeps", "sleeping", "ground", "height", "bodies", "shape", "type", "box", "sphere", "half_extents", "radius",
     "position", "orientation", "linear_velocity", "angular_velocity", "density", "mass", "fixed", "joints", "ball",
     "anchors", "camera", "target", "fov_y", "", "x", "\n", "bodies[0]",
 ];

@@ -122,7 +122,8 @@ const FULL_SCENE: &str = r#"{
     "angular_damping": 0.02,
     "restitution": 0.3,
     "friction": 0.6,
-    "substeps": 4
+    "substeps": 4,
+    "sleeping": false
   },
   "ground": { "height": -0.5 },
   "bodies": [
@@ -153,6 +154,8 @@ const FULL_SCENE: &str = r#"{
 fn full_scene_loads() {
     let scene = Scene::from_json_str(FULL_SCENE).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(scene.settings.substeps, 4);
+    assert!(!scene.settings.sleeping);
+    assert!(Scene::from_json_str(r#"{"bodies": []}"#).unwrap().settings.sleeping, "sleeping is on by default");
     assert_eq!(scene.settings.iterations, 12);
     assert_eq!(scene.ground.map(|g| g.height), Some(-0.5));
     assert_eq!(scene.bodies.len(), 3);
