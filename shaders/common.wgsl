@@ -210,7 +210,8 @@ fn partner_point(c: Contact) -> PartnerPoint {
 // seconds sleeps: integrate holds it still, without gravity, the solve and
 // restitution passes leave it as it is, and every awake body treats it as
 // fixed. It wakes when an awake body touching it moves faster than
-// WAKE_SPEED, and every body wakes after any user input or edit. BodyState
+// WAKE_SPEED or lies more than WAKE_DEPTH inside it, and every body wakes
+// after any user input or edit. BodyState
 // pos.w counts the seconds at rest. Bodies with joints never sleep.
 fn asleep(s: BodyState) -> bool {
     return params.sleep_after > 0.0 && s.pos.w >= params.sleep_after;
@@ -218,6 +219,15 @@ fn asleep(s: BodyState) -> bool {
 
 const SLEEP_SPEED: f32 = 0.05; // m/s
 const WAKE_SPEED: f32 = 0.2;   // m/s
+// An awake body this far inside a sleeper wakes it too (m): it is being
+// squeezed against something that cannot give way.
+const WAKE_DEPTH: f32 = 0.01;
+
+// Whether an awake body touching a sleeper at points `gap` apart (m) wakes it.
+fn wakes(j: u32, gap: f32) -> bool {
+    let o = state_in[j];
+    return !asleep(o) && (gap < -WAKE_DEPTH || point_speed(o, props[j]) > WAKE_SPEED);
+}
 
 // An upper bound of the speed of any point of a body over the last substep
 // (m/s): the centre's speed plus the spin times the bounding radius.

@@ -21,21 +21,20 @@
 // slower than SLEEP_SPEED, at every point, for params.sleep_after seconds
 // while touching something (the solve leaves 1 in prev_pos.w when a contact
 // of the body pushed in the substep); a sleeper wakes when an awake body in
-// its contact list moves faster than WAKE_SPEED at any point; inputs and
+// its contact list moves faster than WAKE_SPEED at any point or lies more
+// than WAKE_DEPTH inside it (`wakes`); inputs and
 // edits wake every body (input.wgsl's wake_all). Box2D's rule is alike (it
 // sleeps whole islands; this sleeps bodies, and a body's awake partners
 // treat it as fixed).
-// Whether an awake body in i's contact list moves fast enough to wake it
+
+// Whether an awake body in i's contact list wakes it
 // (the narrowphase decided alike, and listed all of i's contacts then).
 fn nudged(i: u32) -> bool {
     let first = i * MAX_CONTACTS;
     for (var k = first; k < first + contact_count[i]; k = k + 1u) {
         let j = contacts[k].partner;
-        if (j != GROUND) {
-            let o = state_in[j];
-            if (!asleep(o) && point_speed(o, props[j]) > WAKE_SPEED) {
-                return true;
-            }
+        if (j != GROUND && wakes(j, contacts[k].gap)) {
+            return true;
         }
     }
     return false;

@@ -16,7 +16,7 @@ var<private> self_count: u32;
 var<private> wanted: u32;
 // A sleeping body lists only its contacts with awake bodies (pairs of
 // sleepers and a sleeper's ground contacts are skipped: neither moves)
-// unless one of those awake bodies moves fast enough to wake it (`nudged`);
+// unless one of those awake bodies wakes it (`wakes`: fast, or deep inside);
 // then it lists all of them again, since it wakes in this step's first
 // substep (integrate's `nudged` decides alike from that list).
 var<private> awake_only: bool;
@@ -141,10 +141,9 @@ fn consider(j: u32) {
         return;
     }
     let m = collide(shape_of(lo), shape_of(hi), margin);
-    if (m.count > 0u && !j_asleep && point_speed(state_in[j], pj) > WAKE_SPEED) {
-        nudged_by = true;
-    }
     for (var k = 0u; k < m.count; k = k + 1u) {
+        let point_gap = dot(m.on_b[k] - m.on_a[k], m.normal);
+        nudged_by = nudged_by || wakes(j, point_gap);
         var c: Contact;
         c.partner = j;
         c.pushed = 0.0;
@@ -157,7 +156,7 @@ fn consider(j: u32) {
             c.local_partner = world_to_local(j, m.on_a[k]);
             c.normal = m.normal;
         }
-        add_contact(c, dot(m.on_b[k] - m.on_a[k], m.normal));
+        add_contact(c, point_gap);
     }
 }
 
