@@ -105,8 +105,9 @@ pub struct Settings {
     /// Whether bodies at rest sleep (extension to the contract), default
     /// true: a body slower than 5 cm/s at every point for `SLEEP_AFTER`
     /// seconds while touching something is held still until an awake body
-    /// touching it moves faster than 20 cm/s, or any input or edit wakes
-    /// all. The paper has no sleeping and lists that as a weakness.
+    /// touching it moves faster than 20 cm/s or lies more than 1 cm inside
+    /// it, or any input or edit wakes all. The paper has no sleeping and
+    /// lists that as a weakness.
     pub sleeping: bool,
 }
 
