@@ -236,10 +236,14 @@ fn point_speed(s: BodyState, p: BodyProps) -> f32 {
     return (length(s.pos.xyz - s.prev_pos.xyz) + spin * p.half_extents.w) / params.dt_prev;
 }
 
-// The partner's generalised inverse mass along dir (0 for the ground and for
-// a sleeping body).
+// Whether a contact's partner can be moved by it: not the ground, not asleep.
+fn partner_moves(c: Contact) -> bool {
+    return c.partner != GROUND && !asleep(state_in[c.partner]);
+}
+
+// The partner's generalised inverse mass along dir (0 unless it moves).
 fn partner_inv_mass(c: Contact, r: vec3<f32>, dir: vec3<f32>) -> f32 {
-    if (c.partner == GROUND || asleep(state_in[c.partner])) {
+    if (!partner_moves(c)) {
         return 0.0;
     }
     return effective_inv_mass(props[c.partner], state_in[c.partner].rot, r, dir);

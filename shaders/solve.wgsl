@@ -149,7 +149,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
             partner = c.partner;
         }
         m.pair_w = p.inv_inertia.w;
-        if (c.partner != GROUND && !asleep(state_in[c.partner])) {
+        if (partner_moves(c)) {
             m.pair_w = m.pair_w + props[c.partner].inv_inertia.w;
         }
         let count_before = m.normal_inv_w + m.friction_inv_w;

@@ -53,56 +53,42 @@ pub fn sphere() -> Scene {
 /// and the density is the same at every count (see `pile` for cubes that
 /// land on each other).
 pub fn cubes(count: usize, seed: u64) -> Scene {
-    let mut rng = SplitMix64(seed);
-    let side = ((count as f32 * 1.5).sqrt()).ceil().max(1.0); // cells per row
-    let layers = (count as f32 / (side * side)).ceil().max(1.0);
-    let spacing = 1.5;
-    let mut bodies = Vec::with_capacity(count);
-    'fill: for layer in 0..layers as usize {
-        for row in 0..side as usize {
-            for col in 0..side as usize {
-                if bodies.len() == count {
-                    break 'fill;
-                }
-                let jitter = |r: &mut SplitMix64| (r.next_f32() - 0.5) * 0.3;
-                let x = (col as f32 - side / 2.0) * spacing + jitter(&mut rng);
-                let z = (row as f32 - side / 2.0) * spacing + jitter(&mut rng);
-                let y = 1.0 + layer as f32 * spacing + rng.next_f32() * 0.3;
-                let mut b = box_body([0.5; 3], [x, y, z]);
-                b.orientation = rng.unit_quaternion();
-                bodies.push(b);
-            }
-        }
-    }
-    scene(bodies, vec![])
+    let side = ((count as f32 * 1.5).sqrt()).ceil().max(1.0) as usize; // cells per row
+    scene(scattered_cubes(count, seed, side, 1.5, 1.5, 0.3), vec![])
 }
 
 /// `pile`: `count` unit cubes at random orientations dropped in four
 /// layers, 1.2 m apart within a layer (with 0.2 m of jitter) and 1.5 m
 /// between layers: they land on each other and pile up three and four deep.
 pub fn pile(count: usize, seed: u64) -> Scene {
-    const LAYERS: usize = 4;
+    let side = ((count.div_ceil(4)) as f32).sqrt().ceil().max(1.0) as usize;
+    scene(scattered_cubes(count, seed, side, 1.2, 1.5, 0.2), vec![])
+}
+
+/// `count` unit cubes at random orientations on a `side` x `side` square
+/// of places `spacing` apart, centred on the origin, filled row by row and
+/// layer by layer (layers `rise` apart, the first 1 m up); each place is
+/// moved by up to `jitter` / 2 along x and z and up to `jitter` up.
+fn scattered_cubes(count: usize, seed: u64, side: usize, spacing: f32, rise: f32, jitter: f32) -> Vec<Body> {
     let mut rng = SplitMix64(seed);
-    let side = ((count.div_ceil(LAYERS)) as f32).sqrt().ceil().max(1.0) as usize;
-    let spacing = 1.2;
     let mut bodies = Vec::with_capacity(count);
-    'fill: for layer in 0..LAYERS {
+    'fill: for layer in 0.. {
         for row in 0..side {
             for col in 0..side {
                 if bodies.len() == count {
                     break 'fill;
                 }
-                let jitter = |r: &mut SplitMix64| (r.next_f32() - 0.5) * 0.2;
-                let x = (col as f32 - side as f32 / 2.0) * spacing + jitter(&mut rng);
-                let z = (row as f32 - side as f32 / 2.0) * spacing + jitter(&mut rng);
-                let y = 1.0 + layer as f32 * 1.5 + rng.next_f32() * 0.2;
+                let shift = |r: &mut SplitMix64| (r.next_f32() - 0.5) * jitter;
+                let x = (col as f32 - side as f32 / 2.0) * spacing + shift(&mut rng);
+                let z = (row as f32 - side as f32 / 2.0) * spacing + shift(&mut rng);
+                let y = 1.0 + layer as f32 * rise + rng.next_f32() * jitter;
                 let mut b = box_body([0.5; 3], [x, y, z]);
                 b.orientation = rng.unit_quaternion();
                 bodies.push(b);
             }
         }
     }
-    scene(bodies, vec![])
+    bodies
 }
 
 /// `stack`: `count` unit boxes in a column, each resting on the one below.

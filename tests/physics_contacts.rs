@@ -71,7 +71,7 @@ fn a_thousand_cubes_fall_and_settle() {
 
 /// 1000 cubes that land on each other, three and four deep: the floor of
 /// the issue for a real pile. With sleeping (the default) the pile comes to
-/// rest; the contact lists overflow (up to 37 points wanted, 24 kept: the
+/// rest; the contact lists overflow (up to 35 points wanted, 24 kept: the
 /// closest are kept), which the report says.
 #[test]
 fn a_thousand_cubes_piled_four_deep_settle() {

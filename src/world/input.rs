@@ -425,18 +425,11 @@ impl World {
                 timestamp_writes: None,
             });
             let threads = if kernel == APPLY { ops.len() } else { self.body_count as usize };
+            pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
             pass.set_pipeline(&input.pipelines[kernel]);
-            pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
             pass.dispatch_workgroups((threads as u32).div_ceil(WORKGROUP).max(1), 1, 1);
-        }
-        {
-            // any input wakes every body
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(ENTRY_POINTS[WAKE_ALL]),
-                timestamp_writes: None,
-            });
+            // any input wakes every body (each dispatch sees the last one's writes)
             pass.set_pipeline(&input.pipelines[WAKE_ALL]);
-            pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
             pass.dispatch_workgroups(self.body_count.div_ceil(WORKGROUP).max(1), 1, 1);
         }
         gpu.queue.submit([encoder.finish()]);
