@@ -9,18 +9,26 @@
 // broadphase grid: bodies counted per hash bucket, then sorted by bucket
 @group(0) @binding(5) var<storage, read_write> cell_count: array<atomic<u32>>;  // hash_size
 @group(0) @binding(6) var<storage, read_write> cell_start: array<u32>;          // hash_size + 1
-@group(0) @binding(7) var<storage, read_write> block_sums: array<u32>;          // hash_size / SCAN_BLOCK
+// the block totals of a prefix sum (grid.wgsl's scan): x for the grid, xy for the pairs
+@group(0) @binding(7) var<storage, read_write> block_sums: array<vec2<u32>>;
 @group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // body_count
 @group(0) @binding(9) var<storage, read> large: array<u32>;                     // large_count
-// contacts: MAX_CONTACTS slots per body, filled by the body itself
-@group(0) @binding(10) var<storage, read_write> contacts: array<Contact>;
-@group(0) @binding(11) var<storage, read_write> contact_count: array<u32>;
-// status[0]: most contact points any body wanted this step, status[1]: in any
-// step so far (a full contact list when either exceeds MAX_CONTACTS), both
-// atomicMax-ed from 0; status[2], status[3]: the first numerical fault (see
-// integrate.wgsl): 4 * body + FAULT_* of the lowest body found bad in the
-// first step that found any, and that step's step_index, both atomicMin-ed
-// from NO_FAULT (0xffffffff, written when the buffer is made); 8 words
+// the pair pipeline (pairs.wgsl, narrowphase.wgsl): candidate pairs, each
+// found once; the manifold pool, filled by need; each body's pair list,
+// body i's at body_pairs[pair_meta[i].list_start ..][.. pair_meta[i].total],
+// sorted by pair index
+@group(0) @binding(10) var<storage, read_write> pairs: array<Pair>;             // pair capacity
+@group(0) @binding(11) var<storage, read_write> manifolds: array<ContactManifold>; // manifold capacity
+@group(0) @binding(15) var<storage, read_write> pair_meta: array<PairMeta>;     // body_count + 1
+@group(0) @binding(16) var<storage, read_write> body_pairs: array<u32>;         // 2 x pair capacity
+// status[0]: candidate pairs wanted this step, status[1]: most in any step;
+// status[4]: manifolds used this step, status[5]: most in any step (a pool
+// too small when either exceeds its capacity); status[2], status[3]: the
+// first numerical fault (see integrate.wgsl): 4 * body + FAULT_* of the
+// lowest body found bad in the first step that found any, and that step's
+// step_index, both atomicMin-ed from NO_FAULT (0xffffffff, written when the
+// buffer is made); status[8..11]: the narrowphase's indirect dispatch
+// (workgroups over the pairs, 1, 1), copied out before it runs; 16 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1

@@ -3,7 +3,7 @@
 // the first shape to the second; its points come in pairs (on_a, on_b) whose
 // separation dot(on_b - on_a, n) is negative where the shapes overlap.
 
-const MAX_POINTS: u32 = 4u;
+
 // An edge axis must beat the best face axis by this much (m) to be chosen.
 const EDGE_BIAS: f32 = 0.005;
 

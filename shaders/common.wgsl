@@ -51,23 +51,86 @@ struct Params {
     _pad5: u32,
 }
 
-// One contact point of a body, stored in the body's own slots: the point on
-// the body and the matching point on its partner, each in its owner's frame
-// (the ground's in world coordinates), and the world normal along which this
-// body is pushed out. 48 bytes.
+// A candidate pair found by the broadphase (pairs.wgsl): a < b, or b is
+// GROUND; `manifold` indexes the manifold pool, or NONE when the
+// narrowphase found no points. 12 bytes.
+struct Pair {
+    a: u32,
+    b: u32,
+    manifold: u32,
+}
+
+// One contact point of a pair: the point on each body in that body's own
+// frame (the ground's in world coordinates), and each body's normal push
+// summed over this substep's sweeps (m): its friction budget, written only
+// by that body's own solve and emptied by its restitution pass. 32 bytes.
+struct ContactPoint {
+    local_a: vec3<f32>,
+    pushed_a: f32,
+    local_b: vec3<f32>,
+    pushed_b: f32,
+}
+
+// A pair's contact manifold, found once per step: up to MAX_POINTS points
+// sharing one world normal, pointing from a to b. 144 bytes.
+struct ContactManifold {
+    normal: vec3<f32>,
+    count: u32,
+    points: array<ContactPoint, 4>,
+}
+
+// Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
+// how many pairs it owns (its partner has a higher index, or is the ground)
+// and is in, the prefix sums of both, the cursor its incoming pairs are
+// listed by, its wake flags (WOKEN_*), whether contacts can move it this
+// step, and its bounds: the half extents of its world box grown by its
+// reach (how far it may move this step, m). The entry after the last body
+// holds the totals. 48 bytes.
+struct PairMeta {
+    owned: u32,
+    total: u32,
+    owned_start: u32,
+    list_start: u32,
+    cursor: atomic<u32>,
+    woken: atomic<u32>,
+    moves: u32,
+    _pad0: u32,
+    extent: vec3<f32>,
+    reach: f32,
+}
+
+// pair_meta[i].woken bits: set by the narrowphase when an awake partner
+// wakes a sleeper; moved to WOKEN_LAST by integrate, which wakes the body
+// one step later, once the pair list holds all of its pairs again.
+const WOKEN_NOW: u32 = 1u;
+const WOKEN_LAST: u32 = 2u;
+
+// Points a manifold holds (box-box manifolds are reduced to four).
+const MAX_POINTS: u32 = 4u;
+// No manifold / no pair.
+const NONE: u32 = 0xffffffffu;
+
+// One contact point as one body of its pair sees it (built on the fly from
+// the pair's manifold, never stored): the point on this body and on its
+// partner, each in its owner's frame (the ground's in world coordinates),
+// this body's push so far, and the world normal along which this body is
+// pushed out.
 struct Contact {
     local_self: vec3<f32>,
     partner: u32,            // body index, or GROUND
     local_partner: vec3<f32>,
-    pushed: f32,             // normal push summed over this step's iterations (m): the friction budget
-    normal: vec3<f32>,       // unit, world frame, pointing from the partner to this body
-    gap: f32,                // separation of the two points when found (m; negative: overlap)
+    pushed: f32,
+    normal: vec3<f32>,
 }
 
-// Contact points a body can hold per step (a full list is reported, never
-// silent): a unit box in a pile touches the ground with four corners and
-// about five neighbours with up to four points each.
-const MAX_CONTACTS: u32 = 24u;
+// Point pt of pair pr's manifold (whose normal, a to b, is `normal`) as
+// body `self_is_a ? a : b` sees it.
+fn contact_view(pr: Pair, normal: vec3<f32>, pt: ContactPoint, self_is_a: bool) -> Contact {
+    if (self_is_a) {
+        return Contact(pt.local_a, pr.b, pt.local_b, pt.pushed_a, -normal);
+    }
+    return Contact(pt.local_b, pr.a, pt.local_a, pt.pushed_b, normal);
+}
 
 // Fastest speed (m/s) at which the solve pushes apart bodies that already
 // overlapped at their previous poses (Box2D's contact push speed is 3 m/s).

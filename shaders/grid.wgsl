@@ -5,13 +5,18 @@
 //
 //   grid_clear        buckets: count = 0
 //   grid_count        bodies:  count[bucket of body]++
-//   grid_scan_blocks  buckets: exclusive prefix sum within blocks of SCAN_BLOCK
-//   grid_scan_sums    one workgroup: prefix sum of the block totals
-//   grid_scan_add     buckets: add block offsets -> cell_start; count = 0 again
+//   scan_blocks       buckets: exclusive prefix sum within blocks of SCAN_BLOCK
+//   scan_sums         one workgroup: prefix sum of the block totals
+//   scan_add          buckets: add block offsets -> cell_start; count = 0 again
 //   grid_scatter      bodies:  sorted[cell_start + count++] = body
 //   grid_sort         buckets: sort each bucket's bodies by index (determinism)
 //
 // Bodies in large[] (much bigger than a cell) are not in the grid.
+//
+// The three scan passes serve the pair pipeline too (pairs.wgsl): with the
+// override constant SCAN_PAIRS they sum the bodies' pair counts instead
+// (pair_meta's owned and total -> owned_start and list_start), and the
+// single workgroup also writes the narrowphase's indirect dispatch.
 
 const SCAN_BLOCK: u32 = 256u;
 
@@ -34,26 +39,92 @@ fn grid_clear(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&cell_count[gid.x], 0u);
     }
     if (gid.x == 0u) {
-        atomicStore(&status[0], 0u);
+        atomicStore(&status[4], 0u); // the manifold pool fills anew
     }
 }
 
+// How far body i may move in the coming step, all its substeps (m): its last
+// displacement, rescaled to this step, plus what gravity adds.
+fn reach_of(i: u32) -> f32 {
+    let s = state_in[i];
+    let steps = f32(params.substeps);
+    let ratio = params.dt / params.dt_prev * steps;
+    let h = params.dt * steps;
+    return length(s.pos.xyz - s.prev_pos.xyz) * ratio + length(params.gravity.xyz) * h * h;
+}
+
+// Half extents of body i's world box: |R| h for a box, the radius for a sphere.
+fn world_extent(i: u32) -> vec3<f32> {
+    let p = props[i];
+    if (p.kind.x == SHAPE_SPHERE) {
+        return vec3<f32>(p.half_extents.x);
+    }
+    let q = state_in[i].rot;
+    let x = quat_rotate(q, vec3<f32>(p.half_extents.x, 0.0, 0.0));
+    let y = quat_rotate(q, vec3<f32>(0.0, p.half_extents.y, 0.0));
+    let z = quat_rotate(q, vec3<f32>(0.0, 0.0, p.half_extents.z));
+    return abs(x) + abs(y) + abs(z);
+}
+
+// Counts body i into its bucket and writes what the pair list reads of it
+// (PairMeta's moves, extent and reach; see pairs.wgsl).
 @compute @workgroup_size(WORKGROUP)
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.body_count || !in_grid(i)) {
+    if (i >= params.body_count) {
+        return;
+    }
+    let reach = reach_of(i);
+    let moves = !is_fixed(props[i]) && (!asleep(state_in[i]) || atomicLoad(&pair_meta[i].woken) != 0u);
+    pair_meta[i].moves = u32(moves);
+    pair_meta[i].reach = reach;
+    pair_meta[i].extent = world_extent(i) + vec3<f32>(reach);
+    if (!in_grid(i)) {
         return;
     }
     atomicAdd(&cell_count[bucket_of(cell_of(state_in[i].pos.xyz))], 1u);
 }
 
-var<workgroup> scan_tmp: array<u32, SCAN_BLOCK>;
+// Which prefix sum the scan passes compute (set per pipeline, see above).
+override SCAN_PAIRS: bool = false;
+
+fn scan_len() -> u32 {
+    if (SCAN_PAIRS) {
+        return params.body_count;
+    }
+    return params.hash_size;
+}
+
+fn scan_read(k: u32) -> vec2<u32> {
+    if (SCAN_PAIRS) {
+        return vec2<u32>(pair_meta[k].owned, pair_meta[k].total);
+    }
+    return vec2<u32>(atomicLoad(&cell_count[k]), 0u);
+}
+
+fn scan_write(k: u32, v: vec2<u32>) {
+    if (SCAN_PAIRS) {
+        pair_meta[k].owned_start = v.x;
+        pair_meta[k].list_start = v.y;
+    } else {
+        cell_start[k] = v.x;
+    }
+}
+
+fn scan_start(k: u32) -> vec2<u32> {
+    if (SCAN_PAIRS) {
+        return vec2<u32>(pair_meta[k].owned_start, pair_meta[k].list_start);
+    }
+    return vec2<u32>(cell_start[k], 0u);
+}
+
+var<workgroup> scan_tmp: array<vec2<u32>, SCAN_BLOCK>;
 
 // Inclusive Hillis-Steele scan of scan_tmp; every invocation must call it.
 fn scan_workgroup(lid: u32) {
     for (var offset = 1u; offset < SCAN_BLOCK; offset = offset * 2u) {
         workgroupBarrier();
-        var add = 0u;
+        var add = vec2<u32>(0u);
         if (lid >= offset) {
             add = scan_tmp[lid - offset];
         }
@@ -64,17 +135,17 @@ fn scan_workgroup(lid: u32) {
 }
 
 @compute @workgroup_size(SCAN_BLOCK)
-fn grid_scan_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>,
-                    @builtin(workgroup_id) wid: vec3<u32>) {
+fn scan_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>,
+               @builtin(workgroup_id) wid: vec3<u32>) {
     let h = gid.x;
-    var v = 0u;
-    if (h < params.hash_size) {
-        v = atomicLoad(&cell_count[h]);
+    var v = vec2<u32>(0u);
+    if (h < scan_len()) {
+        v = scan_read(h);
     }
     scan_tmp[lid.x] = v;
     scan_workgroup(lid.x);
-    if (h < params.hash_size) {
-        cell_start[h] = scan_tmp[lid.x] - v; // exclusive
+    if (h < scan_len()) {
+        scan_write(h, scan_tmp[lid.x] - v); // exclusive
     }
     if (lid.x == SCAN_BLOCK - 1u) {
         block_sums[wid.x] = scan_tmp[lid.x];
@@ -84,11 +155,11 @@ fn grid_scan_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(loca
 // One workgroup turns the block totals into exclusive block offsets, each
 // invocation scanning a run of consecutive blocks first.
 @compute @workgroup_size(SCAN_BLOCK)
-fn grid_scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
-    let blocks = (params.hash_size + SCAN_BLOCK - 1u) / SCAN_BLOCK;
+fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
+    let blocks = (scan_len() + SCAN_BLOCK - 1u) / SCAN_BLOCK;
     let run = (blocks + SCAN_BLOCK - 1u) / SCAN_BLOCK;
     let first = lid.x * run;
-    var total = 0u;
+    var total = vec2<u32>(0u);
     for (var k = 0u; k < run; k = k + 1u) {
         if (first + k < blocks) {
             let v = block_sums[first + k];
@@ -105,16 +176,28 @@ fn grid_scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
         }
     }
     if (lid.x == SCAN_BLOCK - 1u) {
-        cell_start[params.hash_size] = scan_tmp[lid.x];
+        let sum = scan_tmp[lid.x];
+        scan_write(scan_len(), sum);
+        if (SCAN_PAIRS) {
+            // the narrowphase runs over the pairs that fit the list
+            let listed = min(sum.x, arrayLength(&pairs));
+            atomicStore(&status[0], sum.x);
+            atomicMax(&status[1], sum.x);
+            atomicStore(&status[8], (listed + WORKGROUP - 1u) / WORKGROUP);
+            atomicStore(&status[9], 1u);
+            atomicStore(&status[10], 1u);
+        }
     }
 }
 
 @compute @workgroup_size(WORKGROUP)
-fn grid_scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
-    if (h < params.hash_size) {
-        cell_start[h] = cell_start[h] + block_sums[h / SCAN_BLOCK];
-        atomicStore(&cell_count[h], 0u);
+    if (h < scan_len()) {
+        scan_write(h, scan_start(h) + block_sums[h / SCAN_BLOCK]);
+        if (!SCAN_PAIRS) {
+            atomicStore(&cell_count[h], 0u);
+        }
     }
 }
 

@@ -41,10 +41,10 @@ const INPUT_VELOCITY: u32 = 2u;
 const INPUT_FIXED: u32 = 3u;
 
 // and bindings.wgsl's state_out (binding 3): the current state buffer
-@group(0) @binding(16) var<uniform> input: InputHeader;
-@group(0) @binding(17) var<storage, read> input_ops: array<InputOp>;
+@group(0) @binding(20) var<uniform> input: InputHeader;
+@group(0) @binding(21) var<storage, read> input_ops: array<InputOp>;
 // the props buffer, writable (switching fixed/dynamic writes it)
-@group(0) @binding(18) var<storage, read_write> props_rw: array<BodyProps>;
+@group(0) @binding(22) var<storage, read_write> props_rw: array<BodyProps>;
 
 // World angular velocity the state implies over the substep h.
 fn implied_spin(s: BodyState, h: f32) -> vec3<f32> {

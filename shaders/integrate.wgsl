@@ -21,23 +21,24 @@
 // slower than SLEEP_SPEED, at every point, for params.sleep_after seconds
 // while touching something (the solve leaves 1 in prev_pos.w when a contact
 // of the body pushed in the substep); a sleeper wakes when an awake body in
-// its contact list moves faster than WAKE_SPEED at any point or lies more
-// than WAKE_DEPTH inside it (`wakes`); inputs and
+// a pair with it moves faster than WAKE_SPEED at any point or lies more
+// than WAKE_DEPTH inside it (`wakes`, found by the narrowphase; the body
+// wakes one step later, see `woken`); inputs and
 // edits wake every body (input.wgsl's wake_all). Box2D's rule is alike (it
 // sleeps whole islands; this sleeps bodies, and a body's awake partners
 // treat it as fixed).
 
-// Whether an awake body in i's contact list wakes it
-// (the narrowphase decided alike, and listed all of i's contacts then).
-fn nudged(i: u32) -> bool {
-    let first = i * MAX_CONTACTS;
-    for (var k = first; k < first + contact_count[i]; k = k + 1u) {
-        let j = contacts[k].partner;
-        if (j != GROUND && wakes(j, contacts[k].gap)) {
-            return true;
-        }
+// Whether body i wakes in this substep: only in a step's first substep, one
+// step after the narrowphase found an awake partner waking it (WOKEN_NOW,
+// moved to WOKEN_LAST here), so that this step's pair list already holds
+// all of its pairs (pairs.wgsl lists a woken sleeper's pairs as a mover's).
+fn woken(i: u32) -> bool {
+    if (params.substep != 0u) {
+        return false;
     }
-    return false;
+    let flags = atomicLoad(&pair_meta[i].woken);
+    atomicStore(&pair_meta[i].woken, select(0u, WOKEN_LAST, (flags & WOKEN_NOW) != 0u));
+    return (flags & WOKEN_LAST) != 0u;
 }
 
 // Beyond these a body is absurd (m, m/s).
@@ -104,11 +105,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let s = state_in[i];
     let p = props[i];
     let dt = params.dt;
-    // a new substep: its contacts' friction budgets start empty
-    let first = i * MAX_CONTACTS;
-    for (var k = first; k < first + contact_count[i]; k = k + 1u) {
-        contacts[k].pushed = 0.0;
-    }
+    let wake = woken(i);
     let fault = fault_of(s);
     if (fault != NO_FAULT) {
         report_fault(i, fault);
@@ -137,7 +134,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     var rest = 0.0;
     if (params.sleep_after > 0.0) {
         if (asleep(s)) {
-            if (params.substep != 0u || !nudged(i)) {
+            if (!wake) {
                 rest = s.pos.w;
             }
         } else if (s.prev_pos.w > 0.0 && joint_start[i] == joint_start[i + 1u] && point_speed(s, p) < SLEEP_SPEED) {

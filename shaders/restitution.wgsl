@@ -33,8 +33,9 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var s = state_in[i];
     let p = props[i];
-    let count = contact_count[i];
-    if (is_fixed(p) || count == 0u || asleep(s)) {
+    let first = pair_meta[i].list_start;
+    let end = min(first + pair_meta[i].total, arrayLength(&body_pairs));
+    if (is_fixed(p) || first == end || asleep(s)) {
         state_out[i] = s;
         return;
     }
@@ -44,49 +45,64 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
-    let first = i * MAX_CONTACTS;
-    for (var k = first; k < first + count; k = k + 1u) {
-        let c = contacts[k];
-        let o = partner_point(c);
-        let n = c.normal;
-        let r = quat_rotate(s.rot, c.local_self);
-        // touching?
-        if (dot((s.pos.xyz + r) - o.point, n) > CONTACT_SLOP) {
+    // the body's pairs in pair order (pairs.wgsl); each point's friction
+    // budget is emptied for the next substep once it has been used here
+    for (var e = first; e < end; e = e + 1u) {
+        let q = body_pairs[e];
+        if (q == NONE || pairs[q].manifold == NONE) {
             continue;
         }
-        // approach speed of the two points before the solve, and now
-        var partner_before = vec3<f32>(0.0);
-        var partner_now = vec3<f32>(0.0);
-        if (c.partner != GROUND) {
-            partner_before = point_velocity(vel0[c.partner], o.r);
-            partner_now = point_velocity(implied_velocity(state_in[c.partner]), o.r);
-        }
-        let relative_now = point_velocity(now, r) - partner_now;
-        let w_self_n = effective_inv_mass(p, s.rot, r, n);
-        var acted = false;
-        // dynamic friction against the sliding left after the solve
-        let v_t = relative_now - n * dot(relative_now, n);
-        let sliding = length(v_t);
-        if (c.pushed > 0.0 && sliding > 1e-6) {
-            let t = v_t / sliding;
-            let cut = min(combined_friction(p, c) * c.pushed / params.dt, sliding);
-            let lambda_t = cut / (effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t));
-            dv = dv - t * (p.inv_inertia.w * lambda_t);
-            dw = dw - inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, t)) * lambda_t;
-            acted = true;
-        }
-        // restitution of a fast approach
-        let approach = dot(point_velocity(before, r) - partner_before, n);
-        let vn = dot(relative_now, n);
-        let target_vn = -combined_restitution(p, c) * approach;
-        if (approach < -threshold && vn < target_vn) {
-            let lambda = (target_vn - vn) / (w_self_n + partner_inv_mass(c, o.r, n));
-            dv = dv + n * (p.inv_inertia.w * lambda);
-            dw = dw + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * lambda;
-            acted = true;
-        }
-        if (acted) {
-            acting = acting + 1u;
+        let pr = pairs[q];
+        let self_is_a = pr.a == i;
+        let normal = manifolds[pr.manifold].normal;
+        for (var k = 0u; k < manifolds[pr.manifold].count; k = k + 1u) {
+            let c = contact_view(pr, normal, manifolds[pr.manifold].points[k], self_is_a);
+            if (self_is_a) {
+                manifolds[pr.manifold].points[k].pushed_a = 0.0;
+            } else {
+                manifolds[pr.manifold].points[k].pushed_b = 0.0;
+            }
+            let o = partner_point(c);
+            let n = c.normal;
+            let r = quat_rotate(s.rot, c.local_self);
+            // touching?
+            if (dot((s.pos.xyz + r) - o.point, n) > CONTACT_SLOP) {
+                continue;
+            }
+            // approach speed of the two points before the solve, and now
+            var partner_before = vec3<f32>(0.0);
+            var partner_now = vec3<f32>(0.0);
+            if (c.partner != GROUND) {
+                partner_before = point_velocity(vel0[c.partner], o.r);
+                partner_now = point_velocity(implied_velocity(state_in[c.partner]), o.r);
+            }
+            let relative_now = point_velocity(now, r) - partner_now;
+            let w_self_n = effective_inv_mass(p, s.rot, r, n);
+            var acted = false;
+            // dynamic friction against the sliding left after the solve
+            let v_t = relative_now - n * dot(relative_now, n);
+            let sliding = length(v_t);
+            if (c.pushed > 0.0 && sliding > 1e-6) {
+                let t = v_t / sliding;
+                let cut = min(combined_friction(p, c) * c.pushed / params.dt, sliding);
+                let lambda_t = cut / (effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t));
+                dv = dv - t * (p.inv_inertia.w * lambda_t);
+                dw = dw - inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, t)) * lambda_t;
+                acted = true;
+            }
+            // restitution of a fast approach
+            let approach = dot(point_velocity(before, r) - partner_before, n);
+            let vn = dot(relative_now, n);
+            let target_vn = -combined_restitution(p, c) * approach;
+            if (approach < -threshold && vn < target_vn) {
+                let lambda = (target_vn - vn) / (w_self_n + partner_inv_mass(c, o.r, n));
+                dv = dv + n * (p.inv_inertia.w * lambda);
+                dw = dw + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * lambda;
+                acted = true;
+            }
+            if (acted) {
+                acting = acting + 1u;
+            }
         }
     }
     dw = dw / f32(max(acting, 1u));

@@ -14,7 +14,7 @@ struct Snap {
 
 // What one partner's points ask for, kept apart until the partner's last
 // point so that it can be scaled and averaged as a whole (see `flush`).
-struct Manifold {
+struct PartnerSum {
     normal_dx: vec3<f32>,   // summed translation of the normal snaps
     normal_inv_w: f32,      // sum over those points of 1 / (w_self + w_partner)
     friction_dx: vec3<f32>, // summed translation of the static-friction snaps
@@ -37,8 +37,8 @@ fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>
 // apart since their previous poses by less than mu times the normal push
 // summed over this substep, the slide is undone; a larger slide is left to
 // dynamic friction in the restitution pass. The snaps are added to the
-// partner's manifold `m`. Returns the push (m).
-fn add_contact(m: ptr<function, Manifold>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
+// partner's sum `m`. Returns the push (m).
+fn add_contact(m: ptr<function, PartnerSum>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
     let o = partner_point(c);
     let n = c.normal;
     let r = quat_rotate(s.rot, c.local_self);
@@ -85,13 +85,13 @@ fn add_contact(m: ptr<function, Manifold>, s: BodyState, p: BodyProps, c: Contac
 // and walk apart. The sum is scaled down to what moving the two bodies apart
 // without turning asks for, never up. The points' turns are averaged: each
 // was computed as if it alone turned the body.
-fn flush(acc: ptr<function, Snap>, m: ptr<function, Manifold>) -> u32 {
+fn flush(acc: ptr<function, Snap>, m: ptr<function, PartnerSum>) -> u32 {
     let touched = u32((*m).points > 0u);
     let n_scale = min(1.0, 1.0 / max((*m).pair_w * (*m).normal_inv_w, 1e-30));
     let f_scale = min(1.0, 1.0 / max((*m).pair_w * (*m).friction_inv_w, 1e-30));
     (*acc).dx = (*acc).dx + (*m).normal_dx * n_scale + (*m).friction_dx * f_scale;
     (*acc).dtheta = (*acc).dtheta + (*m).dtheta / f32(max((*m).points, 1u));
-    *m = Manifold(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
+    *m = PartnerSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
     return touched;
 }
 
@@ -133,36 +133,47 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     var acc = Snap(vec3<f32>(0.0), vec3<f32>(0.0));
-    let first = i * MAX_CONTACTS;
-    let count = contact_count[i];
     var touching = 0u;
     // 1 if a contact pushed in this substep: integrate's test for sleeping
     var pressed = 0.0;
-    // a partner's points are listed together (the narrowphase writes one
-    // manifold per pair)
-    var m = Manifold(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
-    var partner = GROUND;
-    for (var k = first; k < first + count; k = k + 1u) {
-        let c = contacts[k];
-        if (c.partner != partner) {
-            touching = touching + flush(&acc, &m);
-            partner = c.partner;
+    var m = PartnerSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
+    // the body's pairs in pair order (pairs.wgsl), one manifold each
+    let first = pair_meta[i].list_start;
+    let end = min(first + pair_meta[i].total, arrayLength(&body_pairs));
+    for (var e = first; e < end; e = e + 1u) {
+        let q = body_pairs[e];
+        if (q == NONE) {
+            continue;
         }
-        m.pair_w = p.inv_inertia.w;
-        if (partner_moves(c)) {
-            m.pair_w = m.pair_w + props[c.partner].inv_inertia.w;
+        let pr = pairs[q];
+        if (pr.manifold == NONE) {
+            continue;
         }
-        let count_before = m.normal_inv_w + m.friction_inv_w;
-        let push = add_contact(&m, s, p, c);
-        contacts[k].pushed = c.pushed + push;
-        if (c.pushed + push > 0.0) {
-            pressed = 1.0;
+        let self_is_a = pr.a == i;
+        let normal = manifolds[pr.manifold].normal;
+        let points = manifolds[pr.manifold].count;
+        for (var k = 0u; k < points; k = k + 1u) {
+            let c = contact_view(pr, normal, manifolds[pr.manifold].points[k], self_is_a);
+            m.pair_w = p.inv_inertia.w;
+            if (partner_moves(c)) {
+                m.pair_w = m.pair_w + props[c.partner].inv_inertia.w;
+            }
+            let count_before = m.normal_inv_w + m.friction_inv_w;
+            let push = add_contact(&m, s, p, c);
+            if (self_is_a) {
+                manifolds[pr.manifold].points[k].pushed_a = c.pushed + push;
+            } else {
+                manifolds[pr.manifold].points[k].pushed_b = c.pushed + push;
+            }
+            if (c.pushed + push > 0.0) {
+                pressed = 1.0;
+            }
+            if (m.normal_inv_w + m.friction_inv_w != count_before) {
+                m.points = m.points + 1u;
+            }
         }
-        if (m.normal_inv_w + m.friction_inv_w != count_before) {
-            m.points = m.points + 1u;
-        }
+        touching = touching + flush(&acc, &m);
     }
-    touching = touching + flush(&acc, &m);
     for (var k = joint_start[i]; k < joint_start[i + 1u]; k = k + 1u) {
         if (add_joint(&acc, s, p, joint_refs[k])) {
             touching = touching + 1u;

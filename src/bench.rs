@@ -245,7 +245,8 @@ pub struct CaseResult {
     pub integrate_ms_per_pass: Option<f64>,
     /// One pass of the copy kernel over the same number of bodies (ms).
     pub copy_ms_per_pass: Option<f64>,
-    /// Most contact points one body wanted, and whether any list overflowed.
+    /// Most contact manifolds (pairs with contact points) in any step, and
+    /// whether the pair list or the manifold pool overflowed.
     pub max_contacts: u32,
     pub contacts_overflowed: bool,
     /// Mean height of the movable bodies after the last repetition (m).
@@ -332,7 +333,9 @@ pub fn cpu_model() -> String {
 
 /// The bytes `World::with_gpu` allocates for `scene` (mirrors its buffer
 /// sizes: two state buffers, props, vel0, the grid at its rounded hash size,
-/// contacts and counts, status, params slots and the joint lists).
+/// the pair list and manifold pool at their per-body sizes (smaller where a
+/// binding caps them), status, the indirect dispatch, params slots and the
+/// joint lists).
 pub fn gpu_bytes(scene: &Scene) -> u64 {
     let n = scene.bodies.len().max(1) as u64;
     let radii: Vec<f32> = scene.bodies.iter().map(|b| b.bounding_radius()).collect();
@@ -340,18 +343,21 @@ pub fn gpu_bytes(scene: &Scene) -> u64 {
     let size = |s: u64| s.max(16);
     let hash = grid.hash_size as u64;
     let state = std::mem::size_of::<BodyState>() as u64;
-    let contact = std::mem::size_of::<Contact>() as u64;
+    let (pairs, manifolds) = (n * world::PAIRS_PER_BODY, n * world::MANIFOLDS_PER_BODY);
     let joints = (scene.bodies.len() as u64 + 1) * 4 + 2 * scene.joints.len() as u64 * std::mem::size_of::<JointRef>() as u64;
     2 * size(n * state)
         + size(n * std::mem::size_of::<BodyProps>() as u64)
         + size(n * std::mem::size_of::<Velocity>() as u64)
         + size(4 * hash)
         + size(4 * (hash + 1))
-        + size(4 * hash.div_ceil(SCAN_BLOCK as u64))
+        + size(8 * hash.max(n).div_ceil(SCAN_BLOCK as u64))
         + size(4 * n)
         + size(4 * large.len() as u64)
-        + size(n * MAX_CONTACTS as u64 * contact)
-        + size(4 * n)
+        + size(pairs * std::mem::size_of::<Pair>() as u64)
+        + size(manifolds * std::mem::size_of::<ContactManifold>() as u64)
+        + size((n + 1) * std::mem::size_of::<PairMeta>() as u64)
+        + size(2 * pairs * 4)
+        + 64
         + 16
         + PARAMS_STRIDE * 64
         + joints
@@ -876,7 +882,7 @@ fn run_case(
     out.mean_height =
         mean_height(bodies.iter().zip(&scene.bodies).filter(|(_, b)| !b.fixed).map(|(o, _)| o.position[1]));
     let report = world.contact_report()?;
-    out.max_contacts = report.run_max;
+    out.max_contacts = report.manifolds_max;
     out.contacts_overflowed = report.overflowed();
     if profile_steps > 0 {
         let times = world.profile(profile_steps)?;
@@ -1154,7 +1160,7 @@ pub fn table(r: &Report) -> String {
     let _ = writeln!(s, "\nsanity (after the last repetition):\n");
     let _ = writeln!(
         s,
-        "| case | iterations x substeps | first step ms | set-up + 1 step s (later worlds) | mean height m | rapier mean height m | max contacts/body | overflow | load avg start/end |"
+        "| case | iterations x substeps | first step ms | set-up + 1 step s (later worlds) | mean height m | rapier mean height m | max manifolds | overflow | load avg start/end |"
     );
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---|---:|");
     for c in r.cases.iter().filter(|c| c.skipped.is_none()) {

@@ -288,8 +288,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let report = world.contact_report()?;
     if report.overflowed() {
         eprintln!(
-            "warning: contact lists overflowed: a body wanted {} contact points, {} fit; the farthest were dropped",
-            report.run_max, report.capacity
+            "warning: the contact pools overflowed: up to {} candidate pairs ({} fit) and {} manifolds ({} fit) \
+             were wanted in a step; the pairs beyond were dropped",
+            report.pairs_max, report.pair_capacity, report.manifolds_max, report.manifold_capacity
         );
     }
     if let Some((lowest, b)) = bodies.iter().enumerate().min_by(|a, b| a.1.position[1].total_cmp(&b.1.position[1])) {

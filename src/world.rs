@@ -37,18 +37,71 @@ struct WorldData {
     states: [wgpu::Buffer; 2],
     params: wgpu::Buffer,
     status: wgpu::Buffer,
-    contacts: wgpu::Buffer,
-    contact_count: wgpu::Buffer,
-    /// `bind_groups[k]` reads `states[k]` and writes `states[1 - k]`.
-    bind_groups: [wgpu::BindGroup; 2],
+    /// The pair pipeline (shaders/pairs.wgsl): candidate pairs, the
+    /// manifold pool, each body's pair bookkeeping and its pair list.
+    pairs: wgpu::Buffer,
+    manifolds: wgpu::Buffer,
+    pair_meta: wgpu::Buffer,
+    body_pairs: wgpu::Buffer,
+    /// The narrowphase's indirect dispatch, copied from `status` before it.
+    dispatch: wgpu::Buffer,
+    /// `bind_groups[k]` reads `states[k]` and writes `states[1 - k]`
+    /// (always made, right after the buffers).
+    bind_groups: Option<[wgpu::BindGroup; 2]>,
     /// Shapes, masses and materials (written by the input kernel too).
     props: wgpu::Buffer,
     /// What the scene fixed at start-up: the bodies kept out of the grid and
     /// the joint lists (the snapshot's scene hash reads them).
     statics: [wgpu::Buffer; 3],
-    /// Working buffers of the passes (vel0 and the grid), kept alive for
-    /// the bind groups.
-    _scratch: Vec<wgpu::Buffer>,
+    /// Working buffers of the passes: vel0, and the grid's cell_count,
+    /// cell_start, block_sums and sorted.
+    scratch: [wgpu::Buffer; 5],
+}
+
+impl WorldData {
+    /// The step's two bind groups (bindings 1..=16 of shaders/bindings.wgsl),
+    /// with state_in and state_out per direction.
+    fn step_bind_groups(&self, device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> [wgpu::BindGroup; 2] {
+        let [vel0, cell_count, cell_start, block_sums, sorted] = &self.scratch;
+        let [large, joint_start, joint_refs] = &self.statics;
+        let group = |from: usize| {
+            let buffers: [&wgpu::Buffer; STORAGE_BUFFERS as usize] = [
+                &self.props,
+                &self.states[from],
+                &self.states[1 - from],
+                vel0,
+                cell_count,
+                cell_start,
+                block_sums,
+                sorted,
+                large,
+                &self.pairs,
+                &self.manifolds,
+                &self.status,
+                joint_start,
+                joint_refs,
+                &self.pair_meta,
+                &self.body_pairs,
+            ];
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                }),
+            }];
+            for (k, buf) in buffers.iter().enumerate() {
+                entries.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: buf.as_entire_binding() });
+            }
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(if from == 0 { "step A->B" } else { "step B->A" }),
+                layout,
+                entries: &entries,
+            })
+        };
+        [group(0), group(1)]
+    }
 }
 
 /// The broadphase grid's shape, fixed at start-up from the bodies' sizes.
@@ -97,20 +150,26 @@ pub struct StageTimes {
     pub gpu_timestamps: bool,
 }
 
-/// What the GPU reports about the contact lists.
+/// What the GPU reports about the pair list and the manifold pool.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ContactReport {
-    /// Most contact points one body wanted in the last step.
-    pub last_step_max: u32,
-    /// Most contact points one body wanted in any step so far.
-    pub run_max: u32,
-    /// Points a body can hold; more are dropped (the farthest partners').
-    pub capacity: u32,
+    /// Candidate pairs in the last step's list.
+    pub pairs: u32,
+    /// Most candidate pairs in any step so far.
+    pub pairs_max: u32,
+    /// Pairs the list holds; more are dropped (and reported).
+    pub pair_capacity: u32,
+    /// Manifolds (pairs with contact points) in the last step.
+    pub manifolds: u32,
+    /// Most manifolds in any step so far.
+    pub manifolds_max: u32,
+    /// Manifolds the pool holds; more are dropped (and reported).
+    pub manifold_capacity: u32,
 }
 
-/// Bytes of the `status` buffer the GPU reports through (8 words; see
+/// Bytes of the `status` buffer the GPU reports through (16 words; see
 /// shaders/bindings.wgsl, binding 12).
-const STATUS_BYTES: u64 = 32;
+const STATUS_BYTES: u64 = 64;
 /// `status[2]` and `status[3]` before any fault (`NO_FAULT` in integrate.wgsl).
 pub const NO_FAULT: u32 = u32::MAX;
 /// The speed (m/s) and distance from the origin (m) beyond which a body's
@@ -157,19 +216,41 @@ impl std::fmt::Display for Fault {
 }
 
 impl ContactReport {
+    /// Whether any step so far found more pairs or manifolds than fit.
     pub fn overflowed(&self) -> bool {
-        self.run_max > self.capacity
+        self.pairs_max > self.pair_capacity || self.manifolds_max > self.manifold_capacity
     }
 }
 
+/// Candidate pairs the list holds per body at first (pairs a body owns: its
+/// partner has a higher index, or is the ground). A settled pile of cubes
+/// four deep owns about 2.5 (2.1 with other cubes, 0.4 with the ground,
+/// measured); both pools grow when a step fills half (`World::fit_pools`).
+pub const PAIRS_PER_BODY: u64 = 6;
+/// Manifolds the pool holds per body at first (pairs with contact points;
+/// about 2.5 in a settled pile, fewer while bodies fall).
+pub const MANIFOLDS_PER_BODY: u64 = 3;
+
+/// The pair list's and the manifold pool's sizes for `n` bodies on `gpu`:
+/// per body as above, within one storage binding and one dispatch.
+pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
+    let binding = binding_limit(gpu);
+    let by_dispatch = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
+    let pairs = n.saturating_mul(PAIRS_PER_BODY).max(64).min(binding / std::mem::size_of::<Pair>() as u64).min(by_dispatch);
+    let manifolds = n.saturating_mul(MANIFOLDS_PER_BODY).max(64).min(binding / std::mem::size_of::<ContactManifold>() as u64);
+    (pairs, manifolds)
+}
+
 /// Bytes of GPU memory per body: poses (two buffers), properties, velocities,
-/// contact slots and count, and the grid's share (sorted list, about two
-/// hash buckets with their counts and starts).
+/// the pair list (pairs, the bodies' lists of them, their bookkeeping), the
+/// manifold pool, and the grid's share (sorted list, about two hash buckets
+/// with their counts and starts).
 pub fn bytes_per_body() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
-    let contacts = MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64 + 4;
+    let pairs = PAIRS_PER_BODY * (std::mem::size_of::<Pair>() as u64 + 2 * 4) + std::mem::size_of::<PairMeta>() as u64;
+    let manifolds = MANIFOLDS_PER_BODY * std::mem::size_of::<ContactManifold>() as u64;
     let grid = 4 + 2 * 8;
-    2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + contacts + grid
+    2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + pairs + manifolds + grid
 }
 
 pub struct World {
@@ -237,12 +318,22 @@ impl World {
         let vel0 = storage("vel0", (count * std::mem::size_of::<Velocity>()) as u64);
         let cell_count = storage("grid/cell_count", 4 * hash);
         let cell_start = storage("grid/cell_start", 4 * (hash + 1));
-        let block_sums = storage("grid/block_sums", 4 * hash.div_ceil(SCAN_BLOCK as u64));
+        // block totals of the grid's scan and the pairs' (xy)
+        let block_sums = storage("scan/block_sums", 8 * hash.max(count as u64).div_ceil(SCAN_BLOCK as u64));
         let sorted = storage("grid/sorted", 4 * count as u64);
         let large_buf = with_data("grid/large", bytemuck::cast_slice(&large));
-        let contacts = storage("contacts", count as u64 * MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64);
-        let contact_count = storage("contact_count", 4 * count as u64);
+        let (pair_capacity, manifold_capacity) = pair_capacities(&gpu, count as u64);
+        let pairs = storage("pairs", pair_capacity * std::mem::size_of::<Pair>() as u64);
+        let manifolds = storage("manifolds", manifold_capacity * std::mem::size_of::<ContactManifold>() as u64);
+        let pair_meta = storage("pairs/meta", (count as u64 + 1) * std::mem::size_of::<PairMeta>() as u64);
+        let body_pairs = storage("pairs/body_lists", 2 * pair_capacity * 4);
         let status = with_data("status", bytemuck::cast_slice(&STATUS_INIT));
+        let dispatch = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("narrowphase dispatch"),
+            size: 16,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let (starts, refs) = joint_lists(scene);
         let joint_start = with_data("joints/start", bytemuck::cast_slice(&starts));
         let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&refs));
@@ -253,54 +344,22 @@ impl World {
             mapped_at_creation: false,
         });
         let pipelines = StepPipelines::new(&gpu);
-        // bindings 1..=12 of shaders/bindings.wgsl, with state_in/state_out per direction
-        let bind_group = |from: usize| {
-            let buffers: [&wgpu::Buffer; STORAGE_BUFFERS as usize] = [
-                &props_buf,
-                &state_bufs[from],
-                &state_bufs[1 - from],
-                &vel0,
-                &cell_count,
-                &cell_start,
-                &block_sums,
-                &sorted,
-                &large_buf,
-                &contacts,
-                &contact_count,
-                &status,
-                &joint_start,
-                &joint_refs,
-            ];
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &params,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-                }),
-            }];
-            for (k, buf) in buffers.iter().enumerate() {
-                entries.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: buf.as_entire_binding() });
-            }
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(if from == 0 { "step A->B" } else { "step B->A" }),
-                layout: &pipelines.layout,
-                entries: &entries,
-            })
-        };
-        let bind_groups = [bind_group(0), bind_group(1)];
-        gpu.check()?;
-        let data = WorldData {
+        let mut data = WorldData {
             states: state_bufs,
             params,
             status,
-            contacts,
-            contact_count,
-            bind_groups,
+            pairs,
+            manifolds,
+            pair_meta,
+            body_pairs,
+            dispatch,
+            bind_groups: None,
             props: props_buf,
             statics: [large_buf, joint_start, joint_refs],
-            _scratch: vec![vel0, cell_count, cell_start, block_sums, sorted],
+            scratch: [vel0, cell_count, cell_start, block_sums, sorted],
         };
+        data.bind_groups = Some(data.step_bind_groups(device, &pipelines.layout));
+        gpu.check()?;
         let substep_dt = settings.dt / settings.substeps as f32;
         Ok(World {
             gpu,
@@ -375,7 +434,56 @@ impl World {
         let per_batch = (MAX_BATCH / substeps).max(1);
         for chunk in dts.chunks(per_batch) {
             self.encode_and_submit(chunk, substeps);
+            self.fit_pools()?;
         }
+        Ok(())
+    }
+
+    /// Grows the pair list and the manifold pool, before the next step,
+    /// once a step has used more than half of either (a 64-byte blocking
+    /// readback of the status words after every batch of steps). Both are
+    /// rebuilt every step, so nothing is carried over; a pool already at its
+    /// binding's limit stays, and an overflow is reported by
+    /// `contact_report`.
+    fn fit_pools(&mut self) -> Result<(), Error> {
+        let report = self.contact_report()?;
+        let (most_pairs, most_manifolds) = pair_capacities(&self.gpu, u64::MAX);
+        let want = |used: u32, capacity: u32, most: u64| {
+            let grown = (2 * used as u64).max(capacity as u64).min(most);
+            (2 * used as u64 > capacity as u64 && grown > capacity as u64).then_some(grown)
+        };
+        let pairs = want(report.pairs_max, report.pair_capacity, most_pairs);
+        let manifolds = want(report.manifolds_max, report.manifold_capacity, most_manifolds);
+        if pairs.is_none() && manifolds.is_none() {
+            return Ok(());
+        }
+        let device = &self.gpu.device;
+        let storage = |label: &str, size: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        // the last step's pairs and manifolds are copied over, so that
+        // `read_contacts` still reads them
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("grow pools") });
+        let mut grow = |old: &mut wgpu::Buffer, label: &str, size: u64| {
+            let new = storage(label, size);
+            encoder.copy_buffer_to_buffer(old, 0, &new, 0, old.size());
+            *old = new;
+        };
+        if let Some(n) = pairs {
+            grow(&mut self.data.pairs, "pairs", n * std::mem::size_of::<Pair>() as u64);
+            grow(&mut self.data.body_pairs, "pairs/body_lists", 2 * n * 4);
+        }
+        if let Some(n) = manifolds {
+            grow(&mut self.data.manifolds, "manifolds", n * std::mem::size_of::<ContactManifold>() as u64);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines.layout));
+        self.gpu.check()?;
         Ok(())
     }
 
@@ -470,13 +578,21 @@ impl World {
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
         let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
+        if stage.over() == Over::Pairs {
+            // the pair scan wrote the dispatch's size into status[8..11]
+            encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12);
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(stage.name()),
             timestamp_writes: timestamps,
         });
         pass.set_pipeline(self.pipelines.pipeline(stage));
-        pass.set_bind_group(0, &self.data.bind_groups[self.current], &offset);
-        pass.dispatch_workgroups(self.workgroups(stage.over()), 1, 1);
+        let groups = self.data.bind_groups.as_ref().expect("made with the buffers");
+        pass.set_bind_group(0, &groups[self.current], &offset);
+        match stage.over() {
+            Over::Pairs => pass.dispatch_workgroups_indirect(&self.data.dispatch, 0),
+            over => pass.dispatch_workgroups(self.workgroups(over), 1, 1),
+        }
         drop(pass);
         if stage.flips_state() {
             self.current = 1 - self.current;
@@ -529,6 +645,7 @@ impl World {
                 }
             }
             self.finish_steps(&dt, substeps);
+            self.fit_pools()?;
         }
         let n = steps.max(1) as f64;
         Ok(StageTimes {
@@ -542,7 +659,9 @@ impl World {
             Over::Bodies => self.body_count.div_ceil(WORKGROUP),
             Over::Buckets => self.grid.hash_size.div_ceil(WORKGROUP),
             Over::ScanBlocks => self.grid.hash_size.div_ceil(SCAN_BLOCK),
+            Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_BLOCK),
             Over::One => 1,
+            Over::Pairs => unreachable!("the narrowphase is dispatched indirectly"),
         };
         n.max(1)
     }
@@ -552,11 +671,19 @@ impl World {
         self.grid
     }
 
-    /// How full the contact lists got (a blocking readback).
+    /// How full the pair list and the manifold pool got (a blocking readback).
     pub fn contact_report(&self) -> Result<ContactReport, Error> {
-        let bytes = self.gpu.read_buffer(&self.data.status, 16)?;
+        let bytes = self.gpu.read_buffer(&self.data.status, STATUS_BYTES)?;
         let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(ContactReport { last_step_max: v[0], run_max: v[1], capacity: MAX_CONTACTS })
+        let size = |b: &wgpu::Buffer, each: usize| (b.size() / each as u64) as u32;
+        Ok(ContactReport {
+            pairs: v[0],
+            pairs_max: v[1],
+            pair_capacity: size(&self.data.pairs, std::mem::size_of::<Pair>()),
+            manifolds: v[4],
+            manifolds_max: v[5],
+            manifold_capacity: size(&self.data.manifolds, std::mem::size_of::<ContactManifold>()),
+        })
     }
 
     /// The first numerical fault since the world was made or
@@ -576,19 +703,32 @@ impl World {
         Ok(())
     }
 
-    /// The contact points each body gathered in the last step's narrowphase
-    /// (a blocking readback, for tests and debugging).
-    pub fn read_contacts(&self) -> Result<Vec<Vec<Contact>>, Error> {
+    /// The contact points of every body as it sees them, from the last
+    /// step's narrowphase, in its pair order (a blocking readback, for tests
+    /// and debugging).
+    pub fn read_contacts(&self) -> Result<Vec<Vec<BodyContact>>, Error> {
         let n = self.body_count as usize;
-        let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.contact_count, 4 * n.max(1) as u64)?);
-        let size = (n.max(1) * MAX_CONTACTS as usize * std::mem::size_of::<Contact>()) as u64;
-        let all: Vec<Contact> = bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.contacts, size)?);
-        Ok((0..n)
-            .map(|i| {
-                let start = i * MAX_CONTACTS as usize;
-                all[start..start + counts[i].min(MAX_CONTACTS) as usize].to_vec()
-            })
-            .collect())
+        let read = |b: &wgpu::Buffer| self.gpu.read_buffer(b, b.size());
+        let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&read(&self.data.pair_meta)?);
+        let lists: Vec<u32> = bytemuck::pod_collect_to_vec(&read(&self.data.body_pairs)?);
+        let pairs: Vec<Pair> = bytemuck::pod_collect_to_vec(&read(&self.data.pairs)?);
+        let manifolds: Vec<ContactManifold> = bytemuck::pod_collect_to_vec(&read(&self.data.manifolds)?);
+        let mut out = vec![Vec::new(); n];
+        for (i, list) in out.iter_mut().enumerate() {
+            let first = meta[i].list_start as usize;
+            let entries = lists.get(first..first + meta[i].total as usize).unwrap_or(&[]);
+            for &p in entries {
+                let Some(pair) = pairs.get(p as usize) else { continue };
+                let Some(m) = manifolds.get(pair.manifold as usize) else { continue };
+                let me_a = pair.a as usize == i;
+                for pt in &m.points[..m.count as usize] {
+                    let (local_self, partner, local_partner, sign) =
+                        if me_a { (pt.local_a, pair.b, pt.local_b, -1.0) } else { (pt.local_b, pair.a, pt.local_a, 1.0) };
+                    list.push(BodyContact { local_self, partner, local_partner, normal: m.normal.map(|v| v * sign) });
+                }
+            }
+        }
+        Ok(out)
     }
 
     /// Reads every body's pose back and derives its velocities.
@@ -621,9 +761,9 @@ impl World {
     }
 }
 
-/// The status words as made: contact maxima 0 (atomicMax-ed), no fault
-/// (atomicMin-ed), the rest spare.
-const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] = [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0];
+/// The status words as made: pair and manifold counts 0 (maxima
+/// atomicMax-ed), no fault (atomicMin-ed), the rest spare.
+const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] = [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0];
 
 /// The damping per substep that removes `beta` per step: 1 - (1 - beta)^(1/n).
 fn per_substep(beta: f32, substeps: usize) -> f32 {
@@ -781,9 +921,9 @@ fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
     let max = max_bodies(gpu);
     if n as u64 > max {
         return Err(Error::Capacity(format!(
-            "the scene has {n} bodies but this adapter holds at most {max}: each body's contact list takes {} bytes \
+            "the scene has {n} bodies but this adapter holds at most {max}: each body's pose takes {} bytes \
              of one storage buffer, and the adapter binds at most {} bytes",
-            MAX_CONTACTS as usize * std::mem::size_of::<Contact>(),
+            std::mem::size_of::<BodyState>(),
             binding_limit(gpu)
         )));
     }
@@ -794,13 +934,15 @@ fn binding_limit(gpu: &Gpu) -> u64 {
     (gpu.limits.max_storage_buffer_binding_size as u64).min(gpu.limits.max_buffer_size)
 }
 
-/// The most bodies this GPU can hold: the contact lists must fit one
-/// storage binding, the hash table (up to four buckets per body after
-/// rounding to a power of two) too, and a dispatch has a workgroup limit.
+/// The most bodies this GPU can hold: the poses must fit one storage
+/// binding, the hash table (up to four buckets per body after rounding to a
+/// power of two) too, and a dispatch has a workgroup limit. The pair list
+/// and the manifold pool are sized to fit one binding each (see
+/// `pair_capacities`); a pool too small for a scene is reported.
 pub fn max_bodies(gpu: &Gpu) -> u64 {
     let per_binding = binding_limit(gpu);
-    let by_contacts = per_binding / (MAX_CONTACTS as u64 * std::mem::size_of::<Contact>() as u64);
+    let by_state = per_binding / std::mem::size_of::<BodyState>() as u64;
     let by_hash = per_binding / 16;
     let by_groups = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64 / 4;
-    by_contacts.min(by_hash).min(by_groups)
+    by_state.min(by_hash).min(by_groups)
 }

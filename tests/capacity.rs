@@ -1,5 +1,5 @@
 //! Memory and capacity (issue 3, part 6): a scene beyond the adapter's limits
-//! is refused before any allocation; a full contact list is reported.
+//! is refused before any allocation; the pair list grows for a crowded scene.
 
 mod common;
 
@@ -27,25 +27,41 @@ fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
 }
 
 #[test]
-fn a_full_contact_list_is_reported() {
-    // one ball touched by 40 small balls spread over its surface: more points
-    // than one body's list holds
+fn the_pair_pools_grow_for_a_crowded_scene() {
+    // an 8 x 8 x 8 lattice of balls 0.9 diameters apart, no gravity: every
+    // ball's 26 lattice neighbours are candidates (about 10 owned pairs a
+    // body, more than the list holds at first) and its 6 nearest touch it
+    let side = 8usize;
     let mut scene = scenes::stack(0);
     scene.ground = None;
     scene.settings.gravity = [0.0; 3];
-    scene.bodies.push(sphere_body(1.0, [0.0; 3]));
-    let n = 40;
-    for k in 0..n {
-        // Fibonacci sphere
-        let y = 1.0 - 2.0 * (k as f32 + 0.5) / n as f32;
-        let phi = k as f32 * std::f32::consts::PI * (3.0 - 5f32.sqrt());
-        let dir = Vec3::new((1.0 - y * y).sqrt() * phi.cos(), y, (1.0 - y * y).sqrt() * phi.sin());
-        scene.bodies.push(sphere_body(0.2, (dir * 1.19).to_array()));
+    for k in 0..side * side * side {
+        let at = Vec3::new((k % side) as f32, ((k / side) % side) as f32, (k / side / side) as f32) * 0.9;
+        scene.bodies.push(sphere_body(0.5, at.to_array()));
     }
+    let n = scene.bodies.len();
     let Some(mut w) = common::world(&scene) else { return };
+    let before = w.contact_report().unwrap();
     w.step(1).unwrap();
-    let report = w.contact_report().unwrap();
-    eprintln!("{report:?}");
-    assert!(report.overflowed(), "40 touching neighbours did not overflow a list of {}: {report:?}", report.capacity);
-    assert!(report.run_max >= n, "the report undercounts: {report:?}");
+    let first = w.contact_report().unwrap();
+    w.step(1).unwrap();
+    let second = w.contact_report().unwrap();
+    eprintln!("made {before:?}\nafter one step {first:?}\nafter two {second:?}");
+    // pairs of lattice neighbours (face, edge and corner diagonals)
+    let m = side - 1;
+    let lattice_pairs = (3 * m * side * side + 6 * m * m * side + 4 * m * m * m) as u32;
+    assert!(before.pair_capacity < lattice_pairs, "the list held every pair from the start: {before:?}");
+    assert_eq!(first.pairs, lattice_pairs, "the first step's candidate pairs");
+    assert!(second.pair_capacity >= lattice_pairs, "the list did not grow: {second:?}");
+    assert!(!second.overflowed() || second.pairs_max > second.pair_capacity.min(first.pairs), "{second:?}");
+    assert_eq!(second.pairs, lattice_pairs, "the second step's candidate pairs");
+    // after growing, every ball holds a contact with each of its face neighbours
+    let contacts = w.read_contacts().unwrap();
+    for (k, list) in contacts.iter().enumerate().take(n) {
+        let (x, y, z) = (k % side, (k / side) % side, k / side / side);
+        let faces = [x > 0, x < m, y > 0, y < m, z > 0, z < m].iter().filter(|&&b| b).count();
+        let mut partners: Vec<u32> = list.iter().map(|c| c.partner).collect();
+        partners.dedup();
+        assert_eq!(partners.len(), faces, "ball {k} at {x} {y} {z} touches {partners:?}");
+    }
 }

@@ -44,7 +44,10 @@ fn shared_structs_match_member_by_member() {
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });
-    check_layout!(common, Contact { local_self, partner, local_partner, pushed, normal, gap });
+    check_layout!(common, Pair { a, b, manifold });
+    check_layout!(common, ContactPoint { local_a, pushed_a, local_b, pushed_b });
+    check_layout!(common, ContactManifold { normal, count, points });
+    check_layout!(common, PairMeta { owned, total, owned_start, list_start, cursor, woken, moves, _pad0, extent, reach });
 }
 
 #[test]
@@ -61,7 +64,8 @@ fn constants_match() {
     assert_eq!(find("SHAPE_SPHERE"), SHAPE_SPHERE);
     assert_eq!(find("FLAG_FIXED"), FLAG_FIXED);
     assert_eq!(find("WORKGROUP"), WORKGROUP);
-    assert_eq!(find("MAX_CONTACTS"), MAX_CONTACTS);
+    assert_eq!(find("MAX_POINTS"), MAX_POINTS);
+    assert_eq!(find("NONE"), NONE);
     assert_eq!(find("GROUND"), GROUND);
     assert_eq!(find("WORLD"), WORLD);
     // the numerical-fault codes the host decodes (src/world.rs)

@@ -4,6 +4,7 @@
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
 pub const BINDINGS: &str = include_str!("../../shaders/bindings.wgsl");
 pub const GRID: &str = include_str!("../../shaders/grid.wgsl");
+pub const PAIRS: &str = include_str!("../../shaders/pairs.wgsl");
 pub const COLLIDE: &str = include_str!("../../shaders/collide.wgsl");
 pub const NARROWPHASE: &str = include_str!("../../shaders/narrowphase.wgsl");
 pub const INTEGRATE: &str = include_str!("../../shaders/integrate.wgsl");
@@ -11,26 +12,40 @@ pub const SOLVE: &str = include_str!("../../shaders/solve.wgsl");
 pub const RESTITUTION: &str = include_str!("../../shaders/restitution.wgsl");
 
 const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
+const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
 
-/// Every compute pass: its entry point (named like the pass; grid passes
-/// live together in grid.wgsl) and the pieces of its module, in order.
-pub const PASSES: &[(&str, &[&str])] = &[
-    ("grid_clear", GRID_PASS),
-    ("grid_count", GRID_PASS),
-    ("grid_scan_blocks", GRID_PASS),
-    ("grid_scan_sums", GRID_PASS),
-    ("grid_scan_add", GRID_PASS),
-    ("grid_scatter", GRID_PASS),
-    ("grid_sort", GRID_PASS),
-    ("narrowphase", &[COMMON, BINDINGS, GRID, COLLIDE, NARROWPHASE]),
-    ("integrate", &[COMMON, BINDINGS, INTEGRATE]),
-    ("solve", &[COMMON, BINDINGS, SOLVE]),
-    ("restitution", &[COMMON, BINDINGS, RESTITUTION]),
+/// Every compute pass: its name (the label of its compute pass), its entry
+/// point (named like the pass, but for the scan passes, which grid.wgsl
+/// holds once for the grid and the pairs) and the pieces of its module, in
+/// order.
+pub const PASSES: &[(&str, &str, &[&str])] = &[
+    ("grid_clear", "grid_clear", GRID_PASS),
+    ("grid_count", "grid_count", GRID_PASS),
+    ("grid_scan_blocks", "scan_blocks", GRID_PASS),
+    ("grid_scan_sums", "scan_sums", GRID_PASS),
+    ("grid_scan_add", "scan_add", GRID_PASS),
+    ("grid_scatter", "grid_scatter", GRID_PASS),
+    ("grid_sort", "grid_sort", GRID_PASS),
+    ("pairs_count", "pairs_count", PAIRS_PASS),
+    ("pairs_scan_blocks", "scan_blocks", GRID_PASS),
+    ("pairs_scan_sums", "scan_sums", GRID_PASS),
+    ("pairs_scan_add", "scan_add", GRID_PASS),
+    ("pairs_write", "pairs_write", PAIRS_PASS),
+    ("pairs_sort", "pairs_sort", PAIRS_PASS),
+    ("narrowphase", "narrowphase", &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE]),
+    ("integrate", "integrate", &[COMMON, BINDINGS, INTEGRATE]),
+    ("solve", "solve", &[COMMON, BINDINGS, SOLVE]),
+    ("restitution", "restitution", &[COMMON, BINDINGS, RESTITUTION]),
 ];
 
 /// The assembled source of the named pass.
 pub fn pass_source(name: &str) -> Option<String> {
-    PASSES.iter().find(|(n, _)| *n == name).map(|(_, parts)| parts.concat())
+    PASSES.iter().find(|(n, _, _)| *n == name).map(|(_, _, parts)| parts.concat())
+}
+
+/// The entry point of the named pass.
+pub fn entry_point(name: &str) -> Option<&'static str> {
+    PASSES.iter().find(|(n, _, _)| *n == name).map(|(_, e, _)| *e)
 }
 
 /// Parses and validates WGSL with naga, as the device would.

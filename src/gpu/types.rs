@@ -77,21 +77,71 @@ pub struct Params {
     pub _pad5: u32,
 }
 
-/// One contact point held by a body (48 bytes); see `Contact` in common.wgsl.
+/// A candidate pair (12 bytes); see `Pair` in common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct Contact {
+pub struct Pair {
+    pub a: u32,
+    /// A body with a higher index than `a`, or `GROUND`.
+    pub b: u32,
+    /// Index into the manifold pool, or `NONE`.
+    pub manifold: u32,
+}
+
+/// One contact point of a pair's manifold (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ContactPoint {
+    /// On body a, in its frame.
+    pub local_a: [f32; 3],
+    /// Body a's normal push summed over the substep's sweeps (m).
+    pub pushed_a: f32,
+    /// On body b, in its frame (the ground's: world coordinates).
+    pub local_b: [f32; 3],
+    pub pushed_b: f32,
+}
+
+/// A pair's manifold (144 bytes): up to `MAX_POINTS` points sharing one
+/// world normal, pointing from a to b.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ContactManifold {
+    pub normal: [f32; 3],
+    pub count: u32,
+    pub points: [ContactPoint; 4],
+}
+
+/// A body's pair bookkeeping (48 bytes); see `PairMeta` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PairMeta {
+    pub owned: u32,
+    pub total: u32,
+    pub owned_start: u32,
+    pub list_start: u32,
+    pub cursor: u32,
+    pub woken: u32,
+    /// 1 if contacts can move the body this step.
+    pub moves: u32,
+    pub _pad0: u32,
+    /// Half extents of its world box grown by its reach (m).
+    pub extent: [f32; 3],
+    /// How far it may move this step (m).
+    pub reach: f32,
+}
+
+/// One contact point as one body of its pair sees it (host only, from
+/// `World::read_contacts`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BodyContact {
+    /// On this body, in its frame.
     pub local_self: [f32; 3],
     /// Body index, or `GROUND`.
     pub partner: u32,
-    /// In the partner's frame; for the ground, in world coordinates.
+    /// On the partner, in its frame; for the ground, in world coordinates.
     pub local_partner: [f32; 3],
-    /// Normal push summed over the step's iterations (m): the friction budget.
-    pub pushed: f32,
+    /// Unit, world frame, pointing from the partner to this body.
     pub normal: [f32; 3],
-    /// Separation of the two points when the narrowphase found them (m;
-    /// negative: overlap); a full list keeps the smallest.
-    pub gap: f32,
 }
 
 /// One end of a ball joint as the body at that end sees it (32 bytes): its
@@ -112,8 +162,10 @@ pub const WORLD: u32 = u32::MAX;
 /// The partner of a contact with the ground (`GROUND` in WGSL).
 pub const GROUND: u32 = u32::MAX;
 
-/// Contact slots per body (`MAX_CONTACTS` in WGSL).
-pub const MAX_CONTACTS: u32 = 24;
+/// Points a manifold holds (`MAX_POINTS` in WGSL).
+pub const MAX_POINTS: u32 = 4;
+/// No pair / no manifold (`NONE` in WGSL).
+pub const NONE: u32 = u32::MAX;
 /// Buckets summed per workgroup by the grid scan (`SCAN_BLOCK` in WGSL).
 pub const SCAN_BLOCK: u32 = 256;
 

@@ -1,12 +1,13 @@
 //! The compute pipelines of one step, in the order they run:
 //!
 //! 1. `grid_*`       — broadphase: counting sort of bodies into a hashed grid (shaders/grid.wgsl)
-//! 2. `narrowphase`  — each body gathers its contacts (shaders/narrowphase.wgsl, collide.wgsl)
-//! 3. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
-//! 4. `solve`        — `iterations` Jacobi sweeps of corrective snaps (shaders/solve.wgsl)
-//! 5. `restitution`  — bounce, by rewriting the previous pose (shaders/restitution.wgsl)
+//! 2. `pairs_*`      — every candidate pair once, and each body's list of its pairs (shaders/pairs.wgsl)
+//! 3. `narrowphase`  — one invocation per pair: its manifold, into the pool (shaders/narrowphase.wgsl, collide.wgsl)
+//! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
+//! 5. `solve`        — `iterations` Jacobi sweeps of corrective snaps (shaders/solve.wgsl)
+//! 6. `restitution`  — bounce, by rewriting the previous pose (shaders/restitution.wgsl)
 //!
-//! Passes 1-2 only read the state; 3-5 read one state buffer and write the
+//! Passes 1-3 only read the state; 4-6 read one state buffer and write the
 //! other, so the current state flips after each of them. This type holds
 //! only compiled pipelines and their layout; the buffers live in `World`.
 
@@ -23,6 +24,12 @@ pub enum Stage {
     GridScanAdd,
     GridScatter,
     GridSort,
+    PairsCount,
+    PairsScanBlocks,
+    PairsScanSums,
+    PairsScanAdd,
+    PairsWrite,
+    PairsSort,
     Narrowphase,
     Integrate,
     Solve,
@@ -36,12 +43,17 @@ pub enum Over {
     Buckets,
     /// One workgroup of `SCAN_BLOCK` per block of buckets.
     ScanBlocks,
+    /// One workgroup of `SCAN_BLOCK` per block of bodies.
+    BodyScanBlocks,
     /// A single workgroup.
     One,
+    /// The candidate pairs: an indirect dispatch whose size the pair scan
+    /// wrote (status[8..11], copied to the world's `dispatch` buffer).
+    Pairs,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 11] = [
+    pub const ALL: [Stage; 17] = [
         Stage::GridClear,
         Stage::GridCount,
         Stage::GridScanBlocks,
@@ -49,13 +61,20 @@ impl Stage {
         Stage::GridScanAdd,
         Stage::GridScatter,
         Stage::GridSort,
+        Stage::PairsCount,
+        Stage::PairsScanBlocks,
+        Stage::PairsScanSums,
+        Stage::PairsScanAdd,
+        Stage::PairsWrite,
+        Stage::PairsSort,
         Stage::Narrowphase,
         Stage::Integrate,
         Stage::Solve,
         Stage::Restitution,
     ];
 
-    /// The WGSL entry point.
+    /// The pass's name: its label, and the key of its module in
+    /// `shaders::PASSES` (which names its entry point).
     pub fn name(self) -> &'static str {
         match self {
             Stage::GridClear => "grid_clear",
@@ -65,6 +84,12 @@ impl Stage {
             Stage::GridScanAdd => "grid_scan_add",
             Stage::GridScatter => "grid_scatter",
             Stage::GridSort => "grid_sort",
+            Stage::PairsCount => "pairs_count",
+            Stage::PairsScanBlocks => "pairs_scan_blocks",
+            Stage::PairsScanSums => "pairs_scan_sums",
+            Stage::PairsScanAdd => "pairs_scan_add",
+            Stage::PairsWrite => "pairs_write",
+            Stage::PairsSort => "pairs_sort",
             Stage::Narrowphase => "narrowphase",
             Stage::Integrate => "integrate",
             Stage::Solve => "solve",
@@ -77,6 +102,11 @@ impl Stage {
         self.name().starts_with("grid_")
     }
 
+    /// Whether the stage builds the pair list (`pairs_*`).
+    pub fn is_pair_list(self) -> bool {
+        self.name().starts_with("pairs_")
+    }
+
     /// Whether the pass writes state_out (so the current state flips).
     pub fn flips_state(self) -> bool {
         matches!(self, Stage::Integrate | Stage::Solve | Stage::Restitution)
@@ -86,15 +116,17 @@ impl Stage {
         match self {
             Stage::GridClear | Stage::GridScanAdd | Stage::GridSort => Over::Buckets,
             Stage::GridScanBlocks => Over::ScanBlocks,
-            Stage::GridScanSums => Over::One,
+            Stage::GridScanSums | Stage::PairsScanSums => Over::One,
+            Stage::PairsScanBlocks => Over::BodyScanBlocks,
+            Stage::Narrowphase => Over::Pairs,
             _ => Over::Bodies,
         }
     }
 }
 
-/// Storage buffers the step's bind group holds (bindings 1-14 of
+/// Storage buffers the step's bind group holds (bindings 1-16 of
 /// shaders/bindings.wgsl); the device must allow this many per stage.
-pub const STORAGE_BUFFERS: u32 = 14;
+pub const STORAGE_BUFFERS: u32 = 16;
 
 pub struct StepPipelines {
     pub layout: wgpu::BindGroupLayout,
@@ -142,6 +174,7 @@ impl StepPipelines {
             .iter()
             .map(|stage| {
                 let source = shaders::pass_source(stage.name()).expect("every stage has a shader");
+                let constants: &[(&str, f64)] = if stage.is_pair_list() { &[("SCAN_PAIRS", 1.0)] } else { &[] };
                 let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some(stage.name()),
                     source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -150,8 +183,8 @@ impl StepPipelines {
                     label: Some(stage.name()),
                     layout: Some(&pipeline_layout),
                     module: &module,
-                    entry_point: Some(stage.name()),
-                    compilation_options: Default::default(),
+                    entry_point: shaders::entry_point(stage.name()),
+                    compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
                     cache: None,
                 })
             })

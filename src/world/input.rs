@@ -185,9 +185,9 @@ const INPUT_FIXED: u32 = 3;
 
 /// Bindings of shaders/input.wgsl (group 0).
 const BIND_STATE: u32 = 3;
-const BIND_HEADER: u32 = 16;
-const BIND_OPS: u32 = 17;
-const BIND_PROPS: u32 = 18;
+const BIND_HEADER: u32 = 20;
+const BIND_OPS: u32 = 21;
+const BIND_PROPS: u32 = 22;
 
 /// The input kernels' pipelines and buffers, built on a world's first input.
 pub(super) struct InputGpu {
