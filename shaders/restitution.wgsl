@@ -55,6 +55,14 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
         let pr = pairs[q];
         let self_is_a = pr.a == i;
         let normal = manifolds[pr.manifold].normal;
+        // the partner's velocities before the solve and now, once per pair
+        let partner = select(pr.a, pr.b, self_is_a);
+        var partner_v0 = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
+        var partner_v = partner_v0;
+        if (partner != GROUND) {
+            partner_v0 = vel0[partner];
+            partner_v = implied_velocity(state_in[partner]);
+        }
         for (var k = 0u; k < manifolds[pr.manifold].count; k = k + 1u) {
             let c = contact_view(pr, normal, manifolds[pr.manifold].points[k], self_is_a);
             if (self_is_a) {
@@ -70,12 +78,8 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             // approach speed of the two points before the solve, and now
-            var partner_before = vec3<f32>(0.0);
-            var partner_now = vec3<f32>(0.0);
-            if (c.partner != GROUND) {
-                partner_before = point_velocity(vel0[c.partner], o.r);
-                partner_now = point_velocity(implied_velocity(state_in[c.partner]), o.r);
-            }
+            let partner_before = point_velocity(partner_v0, o.r);
+            let partner_now = point_velocity(partner_v, o.r);
             let relative_now = point_velocity(now, r) - partner_now;
             let w_self_n = effective_inv_mass(p, s.rot, r, n);
             var acted = false;

@@ -46,7 +46,8 @@ enum Command {
 #[derive(clap::Args)]
 struct BenchArgs {
     /// Cases, comma-separated: cubes-1k, cubes-10k, cubes-100k, cubes-1m
-    /// (the adapter's maximum when 1M does not fit), pyramid, chain, or
+    /// (the adapter's maximum when 1M does not fit), pile-1k, pile-10k,
+    /// pile-100k, pile-1m (cubes heaped four deep), pyramid, chain, or
     /// SCENE:COUNT. Default: all (with --quick: cubes-1k, cubes-10k, pyramid, chain).
     #[arg(long, value_delimiter = ',')]
     cases: Vec<String>,
