@@ -371,10 +371,12 @@ pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, E
             Some(count) => format!("--count {count}"),
             None => "its default count".to_string(),
         };
-        let whose = if max < MAX_BODIES { "this adapter holds" } else { "a built-in scene is made with" };
-        return Err(Error::Capacity(format!(
-            "--count: the {name} scene with {what} has {bodies} bodies, but {whose} at most {max}"
-        )));
+        let limit = if max < MAX_BODIES {
+            format!("this adapter holds at most {max} (see `verlet info`)")
+        } else {
+            format!("built-in scenes have at most {max} (scenes::MAX_BODIES, more than any adapter holds)")
+        };
+        return Err(Error::Capacity(format!("--count: the {name} scene with {what} has {bodies} bodies, but {limit}")));
     }
     Ok(bodies)
 }
