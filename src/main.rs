@@ -337,6 +337,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         track.check(body_count as usize)?;
     }
     check_outputs(&args)?;
+    let mut recorder = Recorder::open(&args)?;
 
     let gpu = Arc::new(Gpu::new()?);
     let started = Instant::now();
@@ -352,7 +353,6 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if let Some(track) = &track {
         warn_late_events(track, args.steps, scene.settings.dt);
     }
-    let mut recorder = Recorder::open(&args)?;
     let mut world = World::with_gpu(gpu.clone(), &scene)?;
     if recorder.wants_images() {
         recorder.renderer = Some(Renderer::new(&gpu, &scene, args.width, args.height)?);
