@@ -1288,11 +1288,18 @@ fn joint_json(joint: &Joint) -> String {
 /// `depth` (two spaces a level).
 fn object_json(fields: &[(&str, String)], depth: usize) -> String {
     let inner = "  ".repeat(depth + 1);
-    let lines: Vec<String> = fields
-        .iter()
-        .map(|(key, value)| format!("{inner}\"{key}\": {value}"))
-        .collect();
-    format!("{{\n{}\n{}}}", lines.join(",\n"), "  ".repeat(depth))
+    let mut out = String::with_capacity(fields.iter().map(|(k, v)| inner.len() + k.len() + v.len() + 6).sum::<usize>() + 8);
+    out.push('{');
+    if fields.is_empty() {
+        out.push('\n');
+    }
+    for (k, (key, value)) in fields.iter().enumerate() {
+        out.push_str(if k == 0 { "\n" } else { ",\n" });
+        let _ = write!(out, "{inner}\"{key}\": ");
+        out.push_str(value);
+    }
+    let _ = write!(out, "\n{}}}", "  ".repeat(depth));
+    out
 }
 
 /// A JSON list of already formatted items at depth 1, one item per line.
@@ -1300,8 +1307,15 @@ fn list_json(items: &[String]) -> String {
     if items.is_empty() {
         return "[]".to_string();
     }
-    let lines: Vec<String> = items.iter().map(|item| format!("    {item}")).collect();
-    format!("[\n{}\n  ]", lines.join(",\n"))
+    // one string, not a copy per line: a scene of a million bodies is 350 MB of text
+    let mut out = String::with_capacity(items.iter().map(|item| item.len() + 6).sum::<usize>() + 4);
+    out.push('[');
+    for (k, item) in items.iter().enumerate() {
+        out.push_str(if k == 0 { "\n    " } else { ",\n    " });
+        out.push_str(item);
+    }
+    out.push_str("\n  ]");
+    out
 }
 
 /// One number, in the shortest form that reads back to the same f32.
