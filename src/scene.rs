@@ -428,7 +428,9 @@ pub(crate) fn text_problem(text: &str) -> Option<(usize, usize, String)> {
         return Some((1, 1, message.into()));
     }
     if text.trim().is_empty() {
-        return Some((text.matches('\n').count() + 1, 0, "no JSON at all (empty or only blanks): expected an object".into()));
+        // where serde_json stops, in its words, and why
+        let (line, column) = (text.matches('\n').count() + 1, text.rsplit('\n').next().map_or(0, |l| l.chars().count()));
+        return Some((line, column, "EOF while parsing a value: the text is empty (or only blanks); expected an object".into()));
     }
     None
 }

@@ -394,7 +394,7 @@ fn malformed_scene_files_are_named_with_the_line() {
     std::fs::write(&bom, b"\xef\xbb\xbf{\"bodies\": []}").unwrap();
     let empty = dir.join("empty.json");
     std::fs::write(&empty, b"").unwrap();
-    for (file, why) in [(s(&bom), "byte-order mark"), (s(&empty), "empty"), ("/dev/null", "empty")] {
+    for (file, why) in [(s(&bom), "byte-order mark"), (s(&empty), "is empty"), ("/dev/null", "is empty")] {
         assert_refused_quickly(&["run", file, "--steps", "1"], &[file, "line 1", why]);
     }
     assert_refused_quickly(
