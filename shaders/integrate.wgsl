@@ -6,7 +6,8 @@
 // Numerical faults: first, every body's state as read here is checked, every
 // substep, with no readback. A body whose pose is not finite (an infinity or
 // a NaN in pos, prev_pos, rot or prev_rot), lies farther than MAX_DISTANCE
-// from the origin, or moved faster than MAX_SPEED over the last substep is
+// from the origin, moved faster than MAX_SPEED or turned faster than MAX_SPIN
+// (or more than MAX_TURN) over the last substep is
 // flagged in status[2..4] (bindings.wgsl: the lowest such body of the first
 // step that found any, with that step's index) and stopped: it is parked at
 // rest at its last sane pose (its current one if that is finite and within
@@ -41,15 +42,21 @@ fn woken(i: u32) -> bool {
     return (flags & WOKEN_LAST) != 0u;
 }
 
-// Beyond these a body is absurd (m, m/s).
+// Beyond these a body is absurd (m, m/s, rad/s, rad per substep). A pose
+// pair holds less than half a turn per substep (a bigger turn reads as a
+// smaller one the other way), so a spin is also absurd where it turns more
+// than MAX_TURN in one substep, whatever MAX_SPIN allows.
 const MAX_DISTANCE: f32 = 1e6;
 const MAX_SPEED: f32 = 1e4;
+const MAX_SPIN: f32 = 1e4;
+const MAX_TURN: f32 = 3.0;
 // status[3] (and status[2]) before any fault.
 const NO_FAULT: u32 = 0xffffffffu;
 // What was wrong, in the low two bits of status[2] (4 * body + FAULT_*).
 const FAULT_NON_FINITE: u32 = 0u;
 const FAULT_FAR: u32 = 1u;
 const FAULT_FAST: u32 = 2u;
+const FAULT_SPIN: u32 = 3u;
 
 // No infinity or NaN (exponent bits all set): WGSL has no isNan, and x != x
 // may be folded away by a driver's fast-math.
@@ -81,6 +88,10 @@ fn fault_of(s: BodyState) -> u32 {
     let reach = MAX_SPEED * params.dt_prev;
     if (dot(moved, moved) > reach * reach) {
         return FAULT_FAST;
+    }
+    let turned = length(quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))));
+    if (turned > min(MAX_TURN, MAX_SPIN * params.dt_prev)) {
+        return FAULT_SPIN;
     }
     return NO_FAULT;
 }

@@ -107,6 +107,10 @@ impl Case {
                 known.join(", ")
             )));
         }
+        // the count is checked before anything is built (a case of a
+        // billion boxes would take the machine's memory): any adapter's
+        // bound here, the adapter's own in `run_case`
+        scenes::check(scene, count, scenes::MAX_BODIES).map_err(|e| Error::Input(format!("--cases: {spec:?}: {e}")))?;
         let name = match count {
             Some(n) => format!("{scene}-{n}"),
             None => scene.to_string(),
@@ -647,15 +651,23 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     } else {
         opts.cases.iter().flat_map(|s| s.split(',')).map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect()
     };
-    let cases: Vec<Case> = specs.iter().map(|s| Case::parse(s)).collect::<Result<_, _>>()?;
-    // fail on unwritable outputs before the long run, not after it
-    for path in [&opts.json, &opts.csv].into_iter().flatten() {
-        std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .map_err(|source| Error::Io { path: path.display().to_string(), source })?;
+    let blanks = opts.cases.iter().flat_map(|s| s.split(',')).filter(|s| s.trim().is_empty()).count();
+    if !opts.cases.is_empty() && specs.is_empty() {
+        return Err(Error::Input(format!("--cases: names no case (got {:?}); give names, comma-separated", opts.cases.join(","))));
     }
+    if blanks > 0 && !opts.cases.is_empty() {
+        progress!("warning: --cases: {blanks} empty name(s) between commas skipped");
+    }
+    let cases: Vec<Case> = specs.iter().map(|s| Case::parse(s)).collect::<Result<_, _>>()?;
+    // fail on unwritable or clashing outputs before the long run, not after it
+    let outputs: Vec<(&str, &std::path::Path)> = [("--json", &opts.json), ("--csv", &opts.csv)]
+        .into_iter()
+        .filter_map(|(flag, p)| p.as_deref().map(|p| (flag, p)))
+        .collect();
+    for (flag, path) in &outputs {
+        crate::output::check_output(flag, path)?;
+    }
+    crate::output::check_distinct(&[], &outputs)?;
 
     let started = Instant::now();
     let gpu = Arc::new(Gpu::new()?);
@@ -815,23 +827,34 @@ fn run_case(
 ) -> Result<CaseResult, Error> {
     let mut case = case.clone();
     let mut note = None;
-    let mut scene = case.scene();
-    if scene.bodies.len() as u64 > max {
-        // ask the world, so the reason is the one `verlet run` gives
-        let why = match World::with_gpu(gpu.clone(), &scene) {
-            Err(e) => e.to_string(),
-            Ok(_) => format!("{} bodies exceed max_bodies = {max}", scene.bodies.len()),
-        };
-        progress!("{}: does not fit: {why}", case.name);
+    // counted before it is built: a case beyond the adapter is not made
+    let bodies = scenes::body_count(&case.scene, case.count).unwrap_or(0);
+    if bodies > max {
+        let why = scenes::check(&case.scene, case.count, max).err().map_or_else(
+            || format!("{bodies} bodies exceed max_bodies = {max}"),
+            |e| e.to_string(),
+        );
         if case.scene != "cubes" || max == 0 {
-            return Ok(CaseResult { skipped: Some(why), ..blank(&case, &scene, steps, reps) });
+            progress!("warning: {}: does not fit, skipped: {why}", case.name);
+            let empty = scenes::by_name(&case.scene, Some(0), SEED).unwrap_or_default();
+            // estimated from the count: the scene is not built
+            let estimate = world::bytes_per_body().saturating_mul(bodies);
+            return Ok(CaseResult {
+                skipped: Some(why),
+                bodies: bodies as usize,
+                gpu_bytes_estimate: estimate,
+                gpu_bytes: estimate,
+                gpu_bytes_per_body: world::bytes_per_body() as f64,
+                ..blank(&case, &empty, steps, reps)
+            });
         }
         let n = max as usize;
-        note = Some(format!("{} cubes do not fit ({why}); run at the adapter's maximum, {n}", scene.bodies.len()));
+        progress!("warning: {}: does not fit ({why}); running {n} cubes, the adapter's maximum, instead", case.name);
+        note = Some(format!("{bodies} cubes do not fit ({why}); run at the adapter's maximum, {n}"));
         case.count = Some(n);
         case.name = format!("cubes-max ({n})");
-        scene = case.scene();
     }
+    let mut scene = case.scene();
     // both engines sleep, or neither (the peer's default: off)
     scene.settings.sleeping = opts.rapier_sleeping;
     let n = scene.bodies.len();

@@ -1,7 +1,6 @@
 //! The `verlet` command line (INTERFACE.md section 2).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -30,10 +29,10 @@ enum Command {
         /// One of: drop, sphere, cubes, stack, pyramid, chain, bridge, ragdoll.
         name: String,
         /// Bodies, boxes, rows, links, planks or ragdolls, by scene.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
         count: Option<usize>,
         /// Seed of the random scenes (cubes).
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = whole_u64)]
         seed: u64,
     },
     /// The adapter in use, its limits and what a body costs.
@@ -52,20 +51,20 @@ struct BenchArgs {
     #[arg(long, value_delimiter = ',')]
     cases: Vec<String>,
     /// Steps per repetition (default 300; 60 with --quick).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     steps: Option<u64>,
     /// Body-steps per repetition: a case takes min(steps, max(20, this / bodies))
     /// steps, so large cases finish (default 3000000: 300 steps of 10k cubes; 600000 with --quick).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     body_steps: Option<u64>,
     /// Repetitions per case, each from the initial state; the median is reported (default 3; 2 with --quick).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     reps: Option<usize>,
     /// A short run: fewer cases, steps and repetitions.
     #[arg(long)]
     quick: bool,
     /// Steps timed stage by stage after the repetitions (default 10; 3 with --quick; 0: none).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     profile_steps: Option<u64>,
     /// Write the full report as JSON here.
     #[arg(long)]
@@ -77,13 +76,13 @@ struct BenchArgs {
     #[arg(long)]
     no_peer: bool,
     /// Run the peer only for cases of at most this many bodies.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     peer_max_bodies: Option<usize>,
     /// Let bodies sleep, ours and rapier's (off by default in the bench).
     #[arg(long)]
     rapier_sleeping: bool,
     /// rapier's num_solver_iterations (default: rapier's own, 4).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     rapier_iterations: Option<usize>,
 }
 
@@ -95,13 +94,13 @@ struct RunArgs {
     #[arg(long, conflicts_with = "scene")]
     builtin: Option<String>,
     /// --count of the built-in scene.
-    #[arg(long, requires = "builtin")]
+    #[arg(long, requires = "builtin", allow_negative_numbers = true, value_parser = whole_usize)]
     count: Option<usize>,
     /// --seed of the built-in scene.
-    #[arg(long, default_value_t = 1, requires = "builtin")]
+    #[arg(long, default_value_t = 1, requires = "builtin", allow_negative_numbers = true, value_parser = whole_u64)]
     seed: u64,
     /// Steps to take.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     steps: u64,
     /// A scripted input track (JSON: impulses, explosions, poses,
     /// velocities, fixed switches, wind at given times) applied between
@@ -109,7 +108,7 @@ struct RunArgs {
     #[arg(long)]
     input: Option<PathBuf>,
     /// Step length in seconds; overrides settings.dt.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     dt: Option<f32>,
     /// Write the state after the last step here (JSON).
     #[arg(long)]
@@ -118,7 +117,7 @@ struct RunArgs {
     #[arg(long)]
     trace: Option<PathBuf>,
     /// K for --trace, --frames, --gif and --contact-sheet.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = whole_u64)]
     every: u64,
     /// Time every stage of every step (GPU timestamps where the adapter has
     /// them) and print the cost per stage; steps are then submitted one by one.
@@ -139,10 +138,10 @@ struct RunArgs {
     #[arg(long)]
     contact_sheet: Option<PathBuf>,
     /// Frame width in pixels.
-    #[arg(long, default_value_t = 640)]
+    #[arg(long, default_value_t = 640, allow_negative_numbers = true, value_parser = whole_u32)]
     width: u32,
     /// Frame height in pixels.
-    #[arg(long, default_value_t = 480)]
+    #[arg(long, default_value_t = 480, allow_negative_numbers = true, value_parser = whole_u32)]
     height: u32,
 }
 
@@ -154,9 +153,7 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(e) => {
-            // one line: clap's first line names the bad flag and why
-            let text = e.render().to_string();
-            eprintln!("{}", text.lines().next().unwrap_or("error: bad arguments"));
+            eprintln!("{}", clap_line(&e));
             return ExitCode::from(2);
         }
     };
@@ -190,42 +187,129 @@ fn main() -> ExitCode {
     }
 }
 
-fn builtin(name: &str, count: Option<usize>, seed: u64) -> Result<Scene, Error> {
-    scenes::by_name(name, count, seed).ok_or_else(|| {
-        let names: Vec<&str> = scenes::NAMES.iter().map(|(n, _)| *n).collect();
-        Error::Input(format!("unknown scene {name:?}; known: {}", names.join(", ")))
-    })
+/// One line for a command-line error: clap's first line, or for a value
+/// its parser refused, "--flag: what it takes, got VALUE".
+fn clap_line(e: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() == ErrorKind::ValueValidation {
+        if let (Some(ContextValue::String(arg)), Some(ContextValue::String(value)), Some(why)) =
+            (e.get(ContextKind::InvalidArg), e.get(ContextKind::InvalidValue), std::error::Error::source(e))
+        {
+            let flag = arg.split_whitespace().next().unwrap_or(arg);
+            return format!("error: {flag}: {why}, got {value}");
+        }
+    }
+    // clap's first line names the bad flag and why
+    let text = e.render().to_string();
+    text.lines().next().unwrap_or("error: bad arguments").to_string()
+}
+
+/// A whole number flag's value: digits only, no sign, within the type.
+fn whole<T: TryFrom<u128> + std::fmt::Display>(text: &str, max: T) -> Result<T, String> {
+    let text = text.strip_prefix('+').unwrap_or(text);
+    let digits = !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit());
+    let value: Option<u128> = if digits { text.parse().ok() } else { None };
+    match value {
+        None if !digits => Err("must be a non-negative whole number".into()),
+        value => value.and_then(|v| T::try_from(v).ok()).ok_or_else(|| format!("must be at most {max}")),
+    }
+}
+
+fn whole_u64(text: &str) -> Result<u64, String> {
+    whole(text, u64::MAX)
+}
+
+fn whole_usize(text: &str) -> Result<usize, String> {
+    whole(text, usize::MAX)
+}
+
+fn whole_u32(text: &str) -> Result<u32, String> {
+    whole(text, u32::MAX)
+}
+
+/// Warns when `--count` is given to a built-in scene that takes none.
+fn warn_unused_count(name: &str, count: Option<usize>) {
+    if count.is_some() && scenes::body_count(name, None).is_some() && scenes::default_count(name).is_none() {
+        eprintln!("warning: --count: the {name} scene takes no count; ignored");
+    }
 }
 
 fn print_scene(name: &str, count: Option<usize>, seed: u64) -> Result<(), Error> {
-    let scene = builtin(name, count, seed)?;
+    // bounded before it is built: any adapter's limit (`verlet run` checks this one's)
+    let scene = scenes::checked(name, count, seed, scenes::MAX_BODIES)?;
+    warn_unused_count(name, count);
     println!("{}", scene.to_json());
     Ok(())
 }
 
+/// Loads the scene file, naming the file in a syntax error (the field
+/// errors name the field).
+fn load_scene(path: &Path) -> Result<Scene, Error> {
+    Scene::from_path(path).map_err(|e| match e {
+        verlet::SceneError::Syntax { .. } => Error::Input(format!("{}: {e}", path.display())),
+        e => e.into(),
+    })
+}
+
+/// Loads the `--input` track, naming the file and the flag.
+fn load_track(path: &Path) -> Result<Track, Error> {
+    use verlet::track::TrackError;
+    Track::from_path(path).map_err(|e| match e {
+        TrackError::Io { path, error } => Error::Input(format!(
+            "{}: cannot read input track given as --input: {}",
+            path.display(),
+            error.to_string().replace('\n', " ")
+        )),
+        e @ (TrackError::Syntax { .. } | TrackError::SceneGiven(_)) => {
+            Error::Input(format!("--input {}: {e}", path.display()))
+        }
+        e => e.into(),
+    })
+}
+
+/// Checks every output path before anything runs: each can be written
+/// (its directory exists and takes files, it is no directory), and none is
+/// an input or another output.
+fn check_outputs(args: &RunArgs) -> Result<(), Error> {
+    let files = [
+        ("--state-out", &args.state_out),
+        ("--trace", &args.trace),
+        ("--gif", &args.gif),
+        ("--contact-sheet", &args.contact_sheet),
+    ];
+    let mut outputs: Vec<(&str, &Path)> = files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))).collect();
+    if let Some(dir) = &args.frames {
+        outputs.push(("--frames", dir));
+    }
+    let mut inputs: Vec<(&str, &Path)> = Vec::new();
+    if let Some(scene) = &args.scene {
+        inputs.push(("the scene file", scene));
+    }
+    if let Some(track) = &args.input {
+        inputs.push(("the --input track", track));
+    }
+    output::check_distinct(&inputs, &outputs)?;
+    for (flag, path) in files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))) {
+        output::check_output(flag, path)?;
+    }
+    if let Some(dir) = &args.frames {
+        if dir.exists() && !dir.is_dir() {
+            return Err(Error::Input(format!("--frames: cannot create directory {}: a file is there", dir.display())));
+        }
+    }
+    Ok(())
+}
+
 fn run(args: RunArgs) -> Result<(), Error> {
-    // Everything the user gave is checked before the GPU is touched.
-    let mut scene = match (&args.scene, &args.builtin) {
-        (Some(path), _) => Scene::from_path(path)?,
-        (None, Some(name)) => builtin(name, args.count, args.seed)?,
-        (None, None) => return Err(Error::Input("give a scene file or --builtin NAME".into())),
-    };
+    // Everything the user gave is checked before the GPU is touched, and a
+    // built-in scene's size before it is built.
     if let Some(dt) = args.dt {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::Input(format!("--dt: must be a positive number of seconds, got {dt}")));
         }
-        scene.settings.dt = dt;
     }
     if args.every == 0 {
         return Err(Error::Input("--every: must be at least 1".into()));
-    }
-    let track = match (&args.input, args.builtin.as_deref()) {
-        (Some(path), _) => Some(Track::from_path(path)?),
-        (None, Some("blast")) if args.scene.is_none() => Some(scenes::blast_track()),
-        (None, _) => None,
-    };
-    if let Some(track) = &track {
-        track.check(scene.bodies.len())?;
     }
     // The upper bound is the adapter's; Renderer::new checks it, naming the flag.
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
@@ -233,10 +317,43 @@ fn run(args: RunArgs) -> Result<(), Error> {
             return Err(Error::Input(format!("{flag}: must be at least 1 pixel, got 0")));
         }
     }
+    let (file_scene, body_count) = match (&args.scene, &args.builtin) {
+        (Some(path), _) => {
+            let scene = load_scene(path)?;
+            let n = scene.bodies.len() as u64;
+            (Some(scene), n)
+        }
+        (None, Some(name)) => {
+            warn_unused_count(name, args.count);
+            (None, scenes::check(name, args.count, scenes::MAX_BODIES)?)
+        }
+        (None, None) => return Err(Error::Input("give a scene file or --builtin NAME".into())),
+    };
+    let track = match (&args.input, args.builtin.as_deref()) {
+        (Some(path), _) => Some(load_track(path)?),
+        (None, Some("blast")) if args.scene.is_none() => Some(scenes::blast_track()),
+        (None, _) => None,
+    };
+    if let Some(track) = &track {
+        track.check(body_count as usize)?;
+    }
+    check_outputs(&args)?;
     let mut recorder = Recorder::open(&args)?;
 
     let gpu = Arc::new(Gpu::new()?);
     let started = Instant::now();
+    let mut scene = match (file_scene, &args.builtin) {
+        (Some(scene), _) => scene,
+        // the adapter's limit, still before the scene is built
+        (None, Some(name)) => scenes::checked(name, args.count, args.seed, verlet::world::max_bodies(&gpu))?,
+        (None, None) => return Err(Error::Input("give a scene file or --builtin NAME".into())),
+    };
+    if let Some(dt) = args.dt {
+        scene.settings.dt = dt;
+    }
+    if let Some(track) = &track {
+        warn_late_events(track, args.steps, scene.settings.dt);
+    }
     let mut world = World::with_gpu(gpu.clone(), &scene)?;
     if recorder.wants_images() {
         recorder.renderer = Some(Renderer::new(&gpu, &scene, args.width, args.height)?);
@@ -252,19 +369,27 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let stepped = step_and_record(&args, &mut world, track.as_ref(), &mut recorder, &bar, started);
     // cleared on success and on error alike, so no half-drawn bar precedes the message
     bar.finish_and_clear();
-    let stage_ms = stepped?;
     // The GPU flags a non-finite or absurd body every step without a
     // readback; the run reads the flag here once (and read_state, which
     // every trace row calls, reads it too) and fails naming body and step.
-    if let Some(fault) = world.faults()? {
-        return Err(Error::Diverged(fault.to_string()));
-    }
-    let bodies = world.read_state()?;
+    let outcome = stepped.and_then(|stage_ms| match world.faults()? {
+        Some(fault) => Err(Error::Diverged(fault.to_string())),
+        None => Ok((stage_ms, world.read_state()?)),
+    });
+    let (stage_ms, bodies) = match outcome {
+        Ok(done) => done,
+        Err(e) => {
+            // say what was kept; the run's other outputs are not written
+            recorder.abandon(&args);
+            return Err(e);
+        }
+    };
     let wall = started.elapsed();
     let frames_written = recorder.frames_written;
     recorder.finish(args.every, scene.settings.dt)?;
     if let Some(path) = &args.state_out {
-        output::write_file(path, &output::state_json(world.step_count(), world.time(), &bodies))?;
+        output::write_file(path, &output::state_json(world.step_count(), world.time(), &bodies))
+            .map_err(|e| Error::Input(format!("--state-out: {e}")))?;
     }
     let ms = wall.as_secs_f64() * 1e3 / args.steps.max(1) as f64;
     println!(
@@ -295,13 +420,32 @@ fn run(args: RunArgs) -> Result<(), Error> {
         );
     }
     if let Some((lowest, b)) = bodies.iter().enumerate().min_by(|a, b| a.1.position[1].total_cmp(&b.1.position[1])) {
-        let fastest = bodies.iter().map(|b| glam::Vec3::from(b.linear_velocity).length()).fold(0.0, f32::max);
+        let length = |v: [f32; 3]| glam::Vec3::from(v).length();
+        let fastest = |of: fn(&verlet::BodyOutput) -> [f32; 3]| {
+            bodies.iter().enumerate().map(|(k, b)| (k, length(of(b)))).fold((0, 0.0f32), |a, b| if b.1 > a.1 { b } else { a })
+        };
+        let (moving, speed) = fastest(|b| b.linear_velocity);
+        let (spinning, spin) = fastest(|b| b.angular_velocity);
         println!(
-            "lowest body {lowest} at y = {:.3} m; fastest body {fastest:.3} m/s",
+            "lowest body {lowest} at y = {:.3} m; fastest body {speed:.3} m/s (body {moving}); fastest spin {spin:.3} rad/s (body {spinning})",
             b.position[1]
         );
     }
     Ok(())
+}
+
+/// Warns of track events that come after the run's last step: they would
+/// act before a step that is never taken.
+fn warn_late_events(track: &Track, steps: u64, dt: f32) {
+    let late: Vec<f64> = track.events().iter().filter(|e| Track::step_of(e.t, dt) >= steps).map(|e| e.t).collect();
+    if let Some(first) = late.first() {
+        eprintln!(
+            "warning: --input: {} of {} events come at t >= {first} s, after the run's last step (it ends at {:.4} s): they do nothing",
+            late.len(),
+            track.events().len(),
+            steps as f64 * dt as f64
+        );
+    }
 }
 
 /// Per-stage totals (ms over the whole run) and whether GPU timestamps timed them.
@@ -383,25 +527,30 @@ const SHEET_TILES: usize = 24;
 /// What `run` records at steps 0, K, 2K, ... and the last: trace rows,
 /// PNG frames, and the frames kept for a GIF and a contact sheet.
 struct Recorder {
-    trace: Option<(PathBuf, BufWriter<File>)>,
+    /// The trace, written beside its path and renamed there when the run
+    /// succeeds ([`output::AtomicFile`]).
+    trace: Option<(PathBuf, output::AtomicFile)>,
     frames_dir: Option<PathBuf>,
     gif: Option<(PathBuf, Reel)>,
     sheet: Option<(PathBuf, Reel)>,
     /// Made once the GPU is up, if any image is wanted.
     renderer: Option<Renderer>,
     frames_written: u64,
+    /// The last step recorded (trace rows and frames), if any.
+    last_step: Option<u64>,
 }
 
 impl Recorder {
-    /// Creates every output file and directory now, so a bad path fails
-    /// before the run rather than after it.
+    /// Opens the trace (beside its path) and creates the frames directory;
+    /// `check_outputs` has checked every path already. Nothing the user
+    /// had is touched until the run succeeds.
     fn open(args: &RunArgs) -> Result<Recorder, Error> {
         let trace = match &args.trace {
             Some(path) => {
-                let file = File::create(path).map_err(|source| io_err(path, source))?;
-                let mut w = BufWriter::new(file);
-                writeln!(w, "{}", output::TRACE_HEADER).map_err(|source| io_err(path, source))?;
-                Some((path.clone(), w))
+                let flagged = |e: Error| Error::Input(format!("--trace: {e}"));
+                let mut file = output::AtomicFile::create(path).map_err(flagged)?;
+                writeln!(file.writer(), "{}", output::TRACE_HEADER).map_err(|source| flagged(io_err(path, source)))?;
+                Some((path.clone(), file))
             }
             None => None,
         };
@@ -410,24 +559,9 @@ impl Recorder {
                 Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display()))
             })?;
         }
-        let probe = |flag: &str, path: &Path| {
-            File::create(path).map(drop).map_err(|e| Error::Input(format!("{flag}: cannot write {}: {e}", path.display())))
-        };
-        let gif = match &args.gif {
-            Some(path) => {
-                probe("--gif", path)?;
-                Some((path.clone(), Reel::new(GIF_FRAMES, GIF_BOX)))
-            }
-            None => None,
-        };
-        let sheet = match &args.contact_sheet {
-            Some(path) => {
-                probe("--contact-sheet", path)?;
-                Some((path.clone(), Reel::new(SHEET_TILES, SHEET_BOX)))
-            }
-            None => None,
-        };
-        Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer: None, frames_written: 0 })
+        let gif = args.gif.as_ref().map(|path| (path.clone(), Reel::new(GIF_FRAMES, GIF_BOX)));
+        let sheet = args.contact_sheet.as_ref().map(|path| (path.clone(), Reel::new(SHEET_TILES, SHEET_BOX)));
+        Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer: None, frames_written: 0, last_step: None })
     }
 
     fn wants_images(&self) -> bool {
@@ -439,39 +573,75 @@ impl Recorder {
     }
 
     fn record(&mut self, world: &World) -> Result<(), Error> {
-        if let Some((path, w)) = self.trace.as_mut() {
+        if let Some((path, file)) = self.trace.as_mut() {
             let bodies = world.read_state()?;
-            output::write_trace_rows(w, world.step_count(), world.time(), &bodies).map_err(|e| io_err(path, e))?;
+            output::write_trace_rows(file.writer(), world.step_count(), world.time(), &bodies)
+                .map_err(|e| Error::Input(format!("--trace: {}", io_err(path, e))))?;
         }
-        let Some(renderer) = self.renderer.as_mut() else { return Ok(()) };
-        let image = renderer.render(world)?;
-        if let Some(dir) = &self.frames_dir {
-            render::write_png(&image, &dir.join(format!("frame_{:06}.png", self.frames_written)))?;
+        if let Some(renderer) = self.renderer.as_mut() {
+            let image = renderer.render(world)?;
+            if let Some(dir) = &self.frames_dir {
+                let path = dir.join(format!("frame_{:06}.png", self.frames_written));
+                render::write_png(&image, &path).map_err(|e| Error::Input(format!("--frames: {e}")))?;
+            }
+            self.frames_written += 1;
+            for (_, reel) in self.gif.iter_mut().chain(self.sheet.iter_mut()) {
+                reel.push(&image);
+            }
         }
-        self.frames_written += 1;
-        for (_, reel) in self.gif.iter_mut().chain(self.sheet.iter_mut()) {
-            reel.push(&image);
-        }
+        self.last_step = Some(world.step_count());
         Ok(())
     }
 
-    /// Flushes the trace and writes the GIF and the contact sheet.
+    /// Commits the trace and writes the GIF and the contact sheet.
     fn finish(self, every: u64, dt: f32) -> Result<(), Error> {
-        if let Some((path, mut w)) = self.trace {
-            w.flush().map_err(|e| io_err(&path, e))?;
+        if let Some((_, file)) = self.trace {
+            file.commit().map_err(|e| Error::Input(format!("--trace: {e}")))?;
         }
         if let Some((path, reel)) = self.gif {
             // real time where GIF allows: browsers slow delays under 20 ms to 100 ms
             let ms = (every * reel.stride) as f64 * dt as f64 * 1e3;
             let frame_ms = ms.round().clamp(20.0, 10_000.0) as u32;
-            render::write_gif(&reel.finish(), frame_ms, &path)?;
+            render::write_gif(&reel.finish(), frame_ms, &path).map_err(|e| Error::Input(format!("--gif: {e}")))?;
         }
         if let Some((path, reel)) = self.sheet {
             let tiles = reel.finish();
             let columns = (tiles.len() as f64).sqrt().ceil() as u32;
-            render::write_png(&render::contact_sheet(&tiles, columns, None)?, &path)?;
+            render::write_png(&render::contact_sheet(&tiles, columns, None)?, &path)
+                .map_err(|e| Error::Input(format!("--contact-sheet: {e}")))?;
         }
         Ok(())
+    }
+
+    /// After a failed run: keeps the trace rows recorded so far beside the
+    /// trace's path (`PATH.partial`), never at it, and says on stderr what
+    /// was kept and what was not written.
+    fn abandon(self, args: &RunArgs) {
+        let upto = match self.last_step {
+            Some(step) => format!("steps 0 to {step}"),
+            None => "no step".to_string(),
+        };
+        if let Some((path, file)) = self.trace {
+            let mut partial = path.clone().into_os_string();
+            partial.push(".partial");
+            let partial = PathBuf::from(partial);
+            let kept = match self.last_step {
+                Some(_) => match file.keep_as(&partial) {
+                    Ok(()) => format!("its rows of {upto} are in {}", partial.display()),
+                    Err(e) => format!("its rows could not be kept: {e}"),
+                },
+                None => "no rows were recorded".to_string(),
+            };
+            eprintln!("note: --trace: {} was left as it was (the run failed); {kept}", path.display());
+        }
+        if let Some(dir) = &self.frames_dir {
+            eprintln!("note: --frames: {} frames of {upto} were written to {}", self.frames_written, dir.display());
+        }
+        for (flag, path) in [("--gif", &args.gif), ("--contact-sheet", &args.contact_sheet), ("--state-out", &args.state_out)] {
+            if let Some(path) = path {
+                eprintln!("note: {flag}: {} was left as it was (the run failed)", path.display());
+            }
+        }
     }
 }
 

@@ -1,7 +1,9 @@
 //! The output files of INTERFACE.md section 3: the final state as JSON and
 //! the trace as CSV.
 
-use std::io::Write;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
 
 use crate::world::BodyOutput;
 use crate::Error;
@@ -38,7 +40,149 @@ pub fn write_trace_rows(out: &mut impl Write, step: u64, time: f64, bodies: &[Bo
     Ok(())
 }
 
-/// Writes `text` to `path`, naming the path on failure.
-pub fn write_file(path: &std::path::Path, text: &str) -> Result<(), Error> {
-    std::fs::write(path, text).map_err(|source| Error::Io { path: path.display().to_string(), source })
+/// Writes `text` to `path` atomically ([`AtomicFile`]), naming the path on
+/// failure.
+pub fn write_file(path: &Path, text: &str) -> Result<(), Error> {
+    let mut file = AtomicFile::create(path)?;
+    file.writer().write_all(text.as_bytes()).map_err(|source| io_err(path, source))?;
+    file.commit()
+}
+
+fn io_err(path: &Path, source: std::io::Error) -> Error {
+    Error::Io { path: path.display().to_string(), source }
+}
+
+/// An output file written beside its destination under a hidden temporary
+/// name (`.NAME.verlet-PID.tmp`) and renamed over the destination only when
+/// complete ([`AtomicFile::commit`]): a failed or killed run never leaves a
+/// half-written file where a whole one was expected, nor destroys the file
+/// that was there. Dropped uncommitted, the temporary file is removed (a
+/// killed process leaves it behind, under its hidden name).
+pub struct AtomicFile {
+    dest: PathBuf,
+    temp: PathBuf,
+    writer: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file beside `dest` (a symbolic link's target,
+    /// if `dest` is one, so the link stays).
+    pub fn create(dest: &Path) -> Result<AtomicFile, Error> {
+        let dest = std::fs::canonicalize(dest).unwrap_or_else(|_| dest.to_path_buf());
+        let name = dest.file_name().ok_or_else(|| Error::Input(format!("{}: names a directory, not a file", dest.display())))?;
+        let temp = dest.with_file_name(format!(".{}.verlet-{}.tmp", name.to_string_lossy(), std::process::id()));
+        let file = File::create(&temp).map_err(|source| io_err(&dest, source))?;
+        Ok(AtomicFile { dest, temp, writer: Some(BufWriter::new(file)) })
+    }
+
+    /// Where the bytes go until the commit.
+    pub fn writer(&mut self) -> &mut BufWriter<File> {
+        self.writer.as_mut().expect("only commit and keep_as take the writer, and they consume self")
+    }
+
+    /// Flushes the file and renames it over the destination.
+    pub fn commit(mut self) -> Result<(), Error> {
+        let dest = self.dest.clone();
+        self.finish_as(&dest)
+    }
+
+    /// Flushes what was written and renames it to `other` instead (a run's
+    /// partial output, kept apart from the destination).
+    pub fn keep_as(mut self, other: &Path) -> Result<(), Error> {
+        self.finish_as(other)
+    }
+
+    fn finish_as(&mut self, path: &Path) -> Result<(), Error> {
+        let writer = self.writer.take().expect("finished once");
+        let file = writer.into_inner().map_err(|e| io_err(&self.dest, e.into_error()))?;
+        drop(file);
+        std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.writer.take().is_some() {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+    }
+}
+
+/// Checks, before any work, that `path` can be written as the output `flag`
+/// names: it is not a directory, and its directory exists and takes new
+/// files (probed by creating and removing a hidden file there). Creates
+/// nothing that stays.
+pub fn check_output(flag: &str, path: &Path) -> Result<(), Error> {
+    let refuse = |why: String| Err(Error::Input(format!("{flag}: cannot write {}: {why}", path.display())));
+    if path.is_dir() {
+        return refuse("it is a directory".into());
+    }
+    let Some(name) = path.file_name() else {
+        return refuse("it names a directory, not a file".into());
+    };
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        return refuse(format!("no directory {}", dir.display()));
+    }
+    let probe = dir.join(format!(".{}.verlet-{}.probe", name.to_string_lossy(), std::process::id()));
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => refuse(format!("cannot create files in {}: {e}", dir.display())),
+    }
+}
+
+/// The directory a path's file is in (`.` for a bare name).
+fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// The file a path names, for comparing paths: its canonical form if it
+/// exists, else its directory's canonical form joined with its name.
+fn resolve(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    match (std::fs::canonicalize(parent_dir(path)), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Whether two paths name one file (the same inode, through links too).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return x.dev() == y.dev() && x.ino() == y.ino();
+        }
+    }
+    resolve(a) == resolve(b)
+}
+
+/// Refuses an output that names an input, or the same file as another
+/// output: `(flag, path)` pairs, the flag as the user gave it (a scene
+/// file given without a flag is named "the scene").
+pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Result<(), Error> {
+    for (k, (flag, out)) in outputs.iter().enumerate() {
+        if let Some((input, _)) = inputs.iter().find(|(_, p)| same_file(out, p)) {
+            return Err(Error::Input(format!(
+                "{flag}: {} is {input}, an input: writing it would destroy it; give another path",
+                out.display()
+            )));
+        }
+        if let Some((other, _)) = outputs[..k].iter().find(|(_, p)| same_file(out, p)) {
+            return Err(Error::Input(format!(
+                "{flag}: {} is also {other}'s output: one would overwrite the other; give each its own path",
+                out.display()
+            )));
+        }
+    }
+    Ok(())
 }

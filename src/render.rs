@@ -23,7 +23,6 @@
 //! only buffers and textures; a frame allocates nothing but, the first time
 //! it sees each of a world's two state buffers, a bind group for it.
 
-use std::io::BufWriter;
 use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
@@ -1005,10 +1004,11 @@ fn image_error(path: &Path, e: image::ImageError) -> Error {
     }
 }
 
-/// Writes `img` as a PNG file.
+/// Writes `img` as a PNG file, atomically (`output::AtomicFile`).
 pub fn write_png(img: &RgbaImage, path: &Path) -> Result<(), Error> {
-    let file = std::fs::File::create(path).map_err(|e| io_error(path, e))?;
-    img.write_with_encoder(image::codecs::png::PngEncoder::new(BufWriter::new(file))).map_err(|e| image_error(path, e))
+    let mut file = crate::output::AtomicFile::create(path)?;
+    img.write_with_encoder(image::codecs::png::PngEncoder::new(file.writer())).map_err(|e| image_error(path, e))?;
+    file.commit()
 }
 
 /// Writes `frames` (all of one size) as an animated GIF that loops forever,
@@ -1026,14 +1026,17 @@ pub fn write_gif(frames: &[RgbaImage], frame_ms: u32, path: &Path) -> Result<(),
             first.dimensions()
         )));
     }
-    let file = std::fs::File::create(path).map_err(|e| io_error(path, e))?;
-    // speed 10 of 1..30: the encoder's default balance of palette quality and time
-    let mut encoder = image::codecs::gif::GifEncoder::new_with_speed(BufWriter::new(file), 10);
-    encoder.set_repeat(image::codecs::gif::Repeat::Infinite).map_err(|e| image_error(path, e))?;
-    let delay = image::Delay::from_numer_denom_ms(frame_ms, 1);
-    encoder
-        .encode_frames(frames.iter().map(|f| image::Frame::from_parts(f.clone(), 0, 0, delay)))
-        .map_err(|e| image_error(path, e))
+    let mut file = crate::output::AtomicFile::create(path)?;
+    {
+        // speed 10 of 1..30: the encoder's default balance of palette quality and time
+        let mut encoder = image::codecs::gif::GifEncoder::new_with_speed(file.writer(), 10);
+        encoder.set_repeat(image::codecs::gif::Repeat::Infinite).map_err(|e| image_error(path, e))?;
+        let delay = image::Delay::from_numer_denom_ms(frame_ms, 1);
+        encoder
+            .encode_frames(frames.iter().map(|f| image::Frame::from_parts(f.clone(), 0, 0, delay)))
+            .map_err(|e| image_error(path, e))?;
+    }
+    file.commit()
 }
 
 /// `frames` tiled into one image, `columns` to a row in order, each scaled

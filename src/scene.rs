@@ -395,6 +395,9 @@ impl SceneError {
 impl Scene {
     /// Parses and validates a scene from JSON text.
     pub fn from_json_str(text: &str) -> Result<Scene, SceneError> {
+        if let Some((line, column, message)) = text_problem(text) {
+            return Err(SceneError::Syntax { line, column, message });
+        }
         let mut deserializer = serde_json::Deserializer::from_str(text);
         let Obj(raw): Obj<RawScene> = serde_path_to_error::deserialize(&mut deserializer)
             .map_err(|error| json_error(path_string(error.path()), error.into_inner()))?;
@@ -415,6 +418,21 @@ impl Scene {
         })?;
         Scene::from_json_str(&text)
     }
+}
+
+/// What is wrong with JSON text that serde_json would report obscurely: a
+/// UTF-8 byte-order mark, or no text at all. (line, column, message).
+pub(crate) fn text_problem(text: &str) -> Option<(usize, usize, String)> {
+    if text.starts_with('\u{feff}') {
+        let message = "the text starts with a byte-order mark (U+FEFF), which JSON does not allow: save it as UTF-8 without one";
+        return Some((1, 1, message.into()));
+    }
+    if text.trim().is_empty() {
+        // where serde_json stops, in its words, and why
+        let (line, column) = (text.matches('\n').count() + 1, text.rsplit('\n').next().map_or(0, |l| l.chars().count()));
+        return Some((line, column, "EOF while parsing a value: the text is empty (or only blanks); expected an object".into()));
+    }
+    None
 }
 
 /// Turns a serde_json error, and the path of the field it happened in (as
@@ -910,7 +928,7 @@ impl Scene {
             check_finite(ground.height, "ground.height")?;
         }
         for (i, body) in self.bodies.iter().enumerate() {
-            validate_body(body, &format!("bodies[{i}]"))?;
+            validate_body(body, &format!("bodies[{i}]"), &self.settings)?;
         }
         for (i, joint) in self.joints.iter().enumerate() {
             validate_joint(joint, self.bodies.len(), &format!("joints[{i}]"))?;
@@ -954,12 +972,37 @@ fn validate_settings(s: &Settings) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn validate_body(body: &Body, path: &str) -> Result<(), SceneError> {
+/// Why an angular velocity `w` (rad/s) is absurd for substeps of `h` s (0:
+/// any), if it is: faster than `world::MAX_SPIN`, or turning more than
+/// `world::MAX_TURN` in one substep, which a pose pair cannot hold (the
+/// numerical-fault check of integrate.wgsl would stop the body).
+pub fn spin_problem(w: [f32; 3], h: f32) -> Option<String> {
+    use crate::world::{MAX_SPIN, MAX_TURN};
+    let rate = w.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+    if rate > MAX_SPIN as f64 {
+        return Some(format!("spins at {rate:.4e} rad/s; at most {MAX_SPIN:e} rad/s is sane"));
+    }
+    let turn = rate * h as f64;
+    if turn > MAX_TURN as f64 {
+        return Some(format!(
+            "spins at {rate:.1} rad/s, {turn:.2} rad per substep of {h:.3e} s; a body turns at most {MAX_TURN} rad \
+             in one substep (a pose pair holds under half a turn): lower the spin, or raise settings.substeps or lower dt"
+        ));
+    }
+    None
+}
+
+fn validate_body(body: &Body, path: &str, settings: &Settings) -> Result<(), SceneError> {
     check_shape(&body.shape, &format!("{path}.shape"))?;
     check_all_finite(&body.position, &format!("{path}.position"))?;
     check_orientation(body.orientation, &format!("{path}.orientation"))?;
     check_all_finite(&body.linear_velocity, &format!("{path}.linear_velocity"))?;
     check_all_finite(&body.angular_velocity, &format!("{path}.angular_velocity"))?;
+    if !body.fixed {
+        if let Some(why) = spin_problem(body.angular_velocity, settings.dt / settings.substeps as f32) {
+            return Err(SceneError::invalid(format!("{path}.angular_velocity"), why));
+        }
+    }
     check_positive(body.mass, &format!("{path}.mass"))?;
     if let Some(restitution) = body.restitution {
         check_restitution(restitution, &format!("{path}.restitution"))?;
@@ -1247,11 +1290,18 @@ fn joint_json(joint: &Joint) -> String {
 /// `depth` (two spaces a level).
 fn object_json(fields: &[(&str, String)], depth: usize) -> String {
     let inner = "  ".repeat(depth + 1);
-    let lines: Vec<String> = fields
-        .iter()
-        .map(|(key, value)| format!("{inner}\"{key}\": {value}"))
-        .collect();
-    format!("{{\n{}\n{}}}", lines.join(",\n"), "  ".repeat(depth))
+    let mut out = String::with_capacity(fields.iter().map(|(k, v)| inner.len() + k.len() + v.len() + 6).sum::<usize>() + 8);
+    out.push('{');
+    if fields.is_empty() {
+        out.push('\n');
+    }
+    for (k, (key, value)) in fields.iter().enumerate() {
+        out.push_str(if k == 0 { "\n" } else { ",\n" });
+        let _ = write!(out, "{inner}\"{key}\": ");
+        out.push_str(value);
+    }
+    let _ = write!(out, "\n{}}}", "  ".repeat(depth));
+    out
 }
 
 /// A JSON list of already formatted items at depth 1, one item per line.
@@ -1259,8 +1309,15 @@ fn list_json(items: &[String]) -> String {
     if items.is_empty() {
         return "[]".to_string();
     }
-    let lines: Vec<String> = items.iter().map(|item| format!("    {item}")).collect();
-    format!("[\n{}\n  ]", lines.join(",\n"))
+    // one string, not a copy per line: a scene of a million bodies is 350 MB of text
+    let mut out = String::with_capacity(items.iter().map(|item| item.len() + 6).sum::<usize>() + 4);
+    out.push('[');
+    for (k, item) in items.iter().enumerate() {
+        out.push_str(if k == 0 { "\n    " } else { ",\n    " });
+        out.push_str(item);
+    }
+    out.push_str("\n  ]");
+    out
 }
 
 /// One number, in the shortest form that reads back to the same f32.

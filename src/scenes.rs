@@ -2,6 +2,7 @@
 //! the tests and the benchmarks: a name means one scene everywhere.
 
 use crate::scene::{Body, Ground, Joint, Scene, Settings, Shape};
+use crate::Error;
 
 /// A box body at rest with density 1000 kg/m^3.
 pub fn box_body(half_extents: [f32; 3], position: [f32; 3]) -> Body {
@@ -302,20 +303,106 @@ pub const NAMES: &[(&str, &str)] = &[
     ("blast", "a wall of --count x 6 boxes, blown apart at t = 1 s by its default input track"),
 ];
 
-/// The named scene; `count` defaults per scene when `None`.
+/// The most bodies a built-in scene is built with (`verlet scene`,
+/// `verlet run --builtin`, `verlet bench` cases), on any adapter: 2^20. No
+/// adapter holds more, since a pass dispatches at most 65 535 workgroups of
+/// 64 per dimension and the hash table has up to four buckets per body
+/// (`world::max_bodies`); `verlet run` also checks the adapter's own limit.
+pub const MAX_BODIES: u64 = 1 << 20;
+
+/// The default `--count` of a scene that takes one; None for one that
+/// takes none (`drop`, `sphere`) or an unknown name.
+pub fn default_count(name: &str) -> Option<usize> {
+    Some(match name {
+        "cubes" | "pile" => 1000,
+        "stack" | "pyramid" | "blast" | "ragdoll" => 10,
+        "chain" => 21,
+        "hanging" | "bridge" => 20,
+        _ => return None,
+    })
+}
+
+/// The smallest `--count` a scene takes: `hanging` needs two links.
+fn min_count(name: &str) -> usize {
+    if name == "hanging" {
+        2
+    } else {
+        1
+    }
+}
+
+/// The bodies the named scene has at `count` (None: its default), worked
+/// out without building it (saturating, so any count is safe to ask
+/// about); None for an unknown name.
+pub fn body_count(name: &str, count: Option<usize>) -> Option<u64> {
+    let n = count.or_else(|| default_count(name)).unwrap_or(0) as u64;
+    Some(match name {
+        "drop" | "sphere" => 1,
+        "cubes" | "pile" | "stack" | "chain" => n,
+        "hanging" => n.max(2),
+        // rows + (rows - 1) + ... + 1
+        "pyramid" => n.saturating_mul(n.saturating_add(1)) / 2,
+        "bridge" => n.saturating_add(2),
+        // a pile of 10 boxes, then 10 parts per ragdoll
+        "ragdoll" => n.saturating_mul(10).saturating_add(10),
+        "blast" => n.saturating_mul(6),
+        _ => return None,
+    })
+}
+
+/// Checks a built-in scene's name and `--count` before anything is built:
+/// the name is known, the count is one the scene takes (at least 1; 2 for
+/// `hanging`), and the scene has at most `max_bodies` bodies (and
+/// [`MAX_BODIES`]). Returns the scene's body count. Errors name `--count`.
+pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, Error> {
+    let Some(bodies) = body_count(name, count) else {
+        let names: Vec<&str> = NAMES.iter().map(|(n, _)| *n).collect();
+        return Err(Error::Input(format!("unknown scene {name:?}; known: {}", names.join(", "))));
+    };
+    if let Some(count) = count {
+        let min = min_count(name);
+        if default_count(name).is_some() && count < min {
+            return Err(Error::Input(format!("--count: the {name} scene takes at least {min}, got {count}")));
+        }
+    }
+    let max = max_bodies.min(MAX_BODIES);
+    if bodies > max {
+        let what = match count {
+            Some(count) => format!("--count {count}"),
+            None => "its default count".to_string(),
+        };
+        let limit = if max < MAX_BODIES {
+            format!("this adapter holds at most {max} (see `verlet info`)")
+        } else {
+            format!("built-in scenes have at most {max} (scenes::MAX_BODIES, more than any adapter holds)")
+        };
+        return Err(Error::Capacity(format!("--count: the {name} scene with {what} has {bodies} bodies, but {limit}")));
+    }
+    Ok(bodies)
+}
+
+/// The named scene, after [`check`] against `max_bodies`.
+pub fn checked(name: &str, count: Option<usize>, seed: u64, max_bodies: u64) -> Result<Scene, Error> {
+    check(name, count, max_bodies)?;
+    by_name(name, count, seed).ok_or_else(|| Error::Input(format!("unknown scene {name:?}")))
+}
+
+/// The named scene; `count` defaults per scene when `None`. Builds what
+/// it is asked: see [`check`] for a count from a user.
 pub fn by_name(name: &str, count: Option<usize>, seed: u64) -> Option<Scene> {
+    let n = count.or_else(|| default_count(name)).unwrap_or(0);
     Some(match name {
         "drop" => drop(),
         "sphere" => sphere(),
-        "cubes" => cubes(count.unwrap_or(1000), seed),
-        "pile" => pile(count.unwrap_or(1000), seed),
-        "stack" => stack(count.unwrap_or(10)),
-        "pyramid" => pyramid(count.unwrap_or(10)),
-        "chain" => chain(count.unwrap_or(21)),
-        "hanging" => hanging(count.unwrap_or(20)),
-        "bridge" => bridge(count.unwrap_or(20)),
-        "ragdoll" => ragdoll(count.unwrap_or(10)),
-        "blast" => blast(count.unwrap_or(10)),
+        "cubes" => cubes(n, seed),
+        "pile" => pile(n, seed),
+        "stack" => stack(n),
+        "pyramid" => pyramid(n),
+        "chain" => chain(n),
+        "hanging" => hanging(n),
+        "bridge" => bridge(n),
+        "ragdoll" => ragdoll(n),
+        "blast" => blast(n),
         _ => return None,
     })
 }

@@ -110,6 +110,17 @@ impl Action {
     }
 }
 
+/// The first key of a scene's top level (`bodies`, `settings`, ...) that
+/// `text` has, if it is a JSON object without `events`: a scene given as a
+/// track. Asked only of text that failed to load as a track.
+fn scene_key(text: &str) -> Option<String> {
+    let top: serde_json::Map<String, serde_json::Value> = serde_json::from_str(text).ok()?;
+    if top.contains_key("events") {
+        return None;
+    }
+    ["bodies", "settings", "ground", "joints", "camera"].iter().find(|k| top.contains_key(**k)).map(|k| k.to_string())
+}
+
 /// A list of events sorted by time; see the module documentation.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Track {
@@ -128,6 +139,9 @@ pub enum TrackError {
     /// A field is unknown, missing, of the wrong type or has a bad value.
     #[error("{field}: {message}")]
     Invalid { field: String, message: String },
+    /// The file is a scene (it has this top-level key), not a track.
+    #[error("this looks like a scene file (it has {0:?}), not an input track ({{\"events\": [...]}}): a scene goes first, `verlet run SCENE.json --input TRACK.json`")]
+    SceneGiven(String),
 }
 
 impl TrackError {
@@ -160,9 +174,16 @@ impl Track {
     /// Parses and checks a track from JSON text (body indices are checked
     /// against a scene by [`Track::check`]).
     pub fn from_json_str(text: &str) -> Result<Track, TrackError> {
+        if let Some((line, column, message)) = crate::scene::text_problem(text) {
+            return Err(TrackError::Syntax { line, column, message });
+        }
         let mut deserializer = serde_json::Deserializer::from_str(text);
-        let Obj(raw): Obj<RawTrack> = serde_path_to_error::deserialize(&mut deserializer)
-            .map_err(|error| json_error(path_string(error.path()), error.into_inner()))?;
+        let Obj(raw): Obj<RawTrack> = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
+            match scene_key(text) {
+                Some(key) => TrackError::SceneGiven(key),
+                None => json_error(path_string(error.path()), error.into_inner()),
+            }
+        })?;
         deserializer.end().map_err(|error| json_error(None, error))?;
         let raw_events = raw.events.ok_or_else(|| TrackError::invalid("events", "is required but missing"))?;
         let mut events = Vec::with_capacity(raw_events.len());
@@ -368,6 +389,10 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
         Action::SetVelocity { linear, angular, .. } => {
             finite(linear, &at("linear"))?;
             finite(angular, &at("angular"))?;
+            // the turn per substep is checked when applied, against the world's dt
+            if let Some(why) = crate::scene::spin_problem(*angular, 0.0) {
+                return Err(TrackError::invalid(at("angular"), why));
+            }
         }
         Action::Fixed { mass, .. } => {
             if let Some(m) = mass {

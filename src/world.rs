@@ -176,6 +176,11 @@ pub const NO_FAULT: u32 = u32::MAX;
 /// state is absurd (`MAX_SPEED`, `MAX_DISTANCE` in integrate.wgsl).
 pub const MAX_SPEED: f32 = 1e4;
 pub const MAX_DISTANCE: f32 = 1e6;
+/// The spin (rad/s) beyond which a body is absurd, and the most it may turn
+/// in one substep (rad; a pose pair holds under half a turn, pi, per
+/// substep): `MAX_SPIN` and `MAX_TURN` in integrate.wgsl.
+pub const MAX_SPIN: f32 = 1e4;
+pub const MAX_TURN: f32 = 3.0;
 
 /// What was wrong with a faulted body (the low two bits of `status[2]`,
 /// `FAULT_*` in integrate.wgsl).
@@ -187,6 +192,8 @@ pub enum FaultKind {
     TooFar,
     /// Faster than `MAX_SPEED`.
     TooFast,
+    /// Spinning faster than `MAX_SPIN`, or turning more than `MAX_TURN` in a substep.
+    SpinsTooFast,
 }
 
 /// The first numerical fault the GPU found: the lowest body found bad in the
@@ -210,6 +217,9 @@ impl std::fmt::Display for Fault {
             FaultKind::NonFinite => "non-finite".to_string(),
             FaultKind::TooFar => format!("absurd (farther than {MAX_DISTANCE:e} m from the origin)"),
             FaultKind::TooFast => format!("absurd (faster than {MAX_SPEED:e} m/s)"),
+            FaultKind::SpinsTooFast => {
+                format!("absurd (spinning faster than {MAX_SPIN:e} rad/s or {MAX_TURN} rad in one substep)")
+            }
         };
         write!(f, "body {} became {what} at step {}; it was stopped at its last sane pose", self.body, self.step)
     }
@@ -778,7 +788,8 @@ fn decode_fault(code: u32, step: u32) -> Option<Fault> {
     let kind = match code & 3 {
         0 => FaultKind::NonFinite,
         1 => FaultKind::TooFar,
-        _ => FaultKind::TooFast,
+        2 => FaultKind::TooFast,
+        _ => FaultKind::SpinsTooFast,
     };
     Some(Fault { body: (code / 4) as usize, step: step as u64, kind })
 }

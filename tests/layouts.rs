@@ -78,7 +78,9 @@ fn constants_match() {
     assert!(matches!(constant("NO_FAULT"), naga::Expression::Literal(naga::Literal::U32(verlet::world::NO_FAULT))));
     assert!(matches!(constant("MAX_SPEED"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_SPEED));
     assert!(matches!(constant("MAX_DISTANCE"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_DISTANCE));
-    for (name, code) in [("FAULT_NON_FINITE", 0u32), ("FAULT_FAR", 1), ("FAULT_FAST", 2)] {
+    assert!(matches!(constant("MAX_SPIN"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_SPIN));
+    assert!(matches!(constant("MAX_TURN"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_TURN));
+    for (name, code) in [("FAULT_NON_FINITE", 0u32), ("FAULT_FAR", 1), ("FAULT_FAST", 2), ("FAULT_SPIN", 3)] {
         assert!(matches!(constant(name), naga::Expression::Literal(naga::Literal::U32(v)) if v == code), "{name}");
     }
     let grid = format!("{}{}{}", shaders::COMMON, shaders::BINDINGS, shaders::GRID);

@@ -13,6 +13,11 @@ pub enum GpuError {
     NoAdapter(String),
     #[error("WGPU_ADAPTER_NAME={0:?} matches no adapter; found: {1}")]
     AdapterNameMismatch(String, String),
+    /// An adapter-choosing environment variable (`WGPU_BACKEND`,
+    /// `WGPU_POWER_PREF`) holds a value wgpu does not know: (variable, value,
+    /// the values it takes).
+    #[error("{0}={1:?} is not valid; it takes {2}")]
+    BadEnv(&'static str, String, String),
     #[error("could not open the GPU device: {0}")]
     Device(String),
     #[error("GPU error: {0}")]
@@ -72,6 +77,9 @@ impl Gpu {
     }
 
     async fn new_async() -> Result<Gpu, GpuError> {
+        // wgpu skips names it does not know, and with none left finds no
+        // adapter at all: say which variable is wrong instead
+        check_env()?;
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
             Ok(wanted) if !wanted.is_empty() => {
@@ -204,6 +212,29 @@ impl Gpu {
         staging.unmap();
         Ok(bytes)
     }
+}
+
+/// The names `WGPU_BACKEND` takes (wgpu_types::Backends::from_comma_list).
+const BACKEND_NAMES: &[&str] = &["vulkan", "vk", "dx12", "d3d12", "metal", "mtl", "opengl", "gles", "gl", "webgpu", "noop"];
+/// The values `WGPU_POWER_PREF` takes (wgpu_types::PowerPreference::from_env).
+const POWER_PREFS: &[&str] = &["low", "high", "none"];
+
+/// Refuses a `WGPU_BACKEND` or `WGPU_POWER_PREF` that wgpu would ignore.
+fn check_env() -> Result<(), GpuError> {
+    if let Ok(value) = std::env::var("WGPU_BACKEND") {
+        let known = |b: &str| BACKEND_NAMES.contains(&b.trim().to_lowercase().as_str());
+        if value.trim().is_empty() || !value.split(',').all(known) {
+            let takes = format!("a comma-separated list of: {}", BACKEND_NAMES.join(", "));
+            return Err(GpuError::BadEnv("WGPU_BACKEND", value, takes));
+        }
+    }
+    if let Ok(value) = std::env::var("WGPU_POWER_PREF") {
+        // wgpu takes an unknown one as the default; empty reads as unset
+        if !value.is_empty() && !POWER_PREFS.contains(&value.to_lowercase().as_str()) {
+            return Err(GpuError::BadEnv("WGPU_POWER_PREF", value, format!("one of: {}", POWER_PREFS.join(", "))));
+        }
+    }
+    Ok(())
 }
 
 /// GPU timestamps around a run of compute passes: pass k writes queries 2k

@@ -376,6 +376,10 @@ impl World {
                 BodyInput::Velocity { linear, angular, .. } => {
                     check_finite(&at("linear"), &linear)?;
                     check_finite(&at("angular"), &angular)?;
+                    let substep = self.settings.dt / self.settings.substeps as f32;
+                    if let Some(why) = crate::scene::spin_problem(angular, substep) {
+                        return Err(Error::Input(format!("{}: {why}", at("angular"))));
+                    }
                     op.kind = INPUT_VELOCITY;
                     op.a = [linear[0], linear[1], linear[2], 0.0];
                     op.b = [angular[0], angular[1], angular[2], 0.0];

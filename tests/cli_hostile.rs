@@ -1,0 +1,451 @@
+//! Careless and hostile use (issue 16): every case is refused with a
+//! non-zero exit, no panic, a message naming the flag, field or file, and
+//! nothing of the user's destroyed or half-written. Refusals that must come
+//! before any scene is built are timed (a generous bound: it asserts that no
+//! work was done, not a speed). Every child runs under a 4 GB address-space
+//! cap, so a regression cannot take the machine's memory.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+use common::{no_adapter, temp_path};
+use verlet::scene::Scene;
+use verlet::scenes;
+
+/// Refusals that must happen before anything is built finish within this.
+const QUICK: Duration = Duration::from_secs(5);
+
+/// Runs `verlet args` under `ulimit -v` (4 GB), with `env` set; returns the
+/// output and how long it took.
+fn capped_env(args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
+    let started = Instant::now();
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 4000000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_verlet"))
+        .args(args)
+        .envs(env.iter().copied())
+        .output()
+        .expect("sh runs verlet");
+    (out, started.elapsed())
+}
+
+fn capped(args: &[&str]) -> (Output, Duration) {
+    capped_env(args, &[])
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The last line of stderr (Mesa may warn first), which must be the error.
+fn reason(out: &Output) -> String {
+    stderr(out).trim_end().lines().last().unwrap_or_default().to_string()
+}
+
+/// A refusal: non-zero exit, no panic, an `error:` line containing every
+/// one of `wanted`.
+fn assert_refused(args: &[&str], out: &Output, wanted: &[&str]) {
+    let err = stderr(out);
+    assert!(!out.status.success(), "{args:?}: exit status 0; stderr {err:?}");
+    assert!(!err.contains("panicked"), "{args:?}: panicked: {err}");
+    let line = reason(out);
+    assert!(line.starts_with("error: "), "{args:?}: last line {line:?}");
+    for w in wanted {
+        assert!(line.contains(w), "{args:?}: expected {w:?} in {line:?}");
+    }
+}
+
+/// A refusal that must come before anything is built.
+fn assert_refused_quickly(args: &[&str], wanted: &[&str]) {
+    let (out, took) = capped(args);
+    assert_refused(args, &out, wanted);
+    assert!(took < QUICK, "{args:?}: refused only after {took:?}");
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("temp paths are UTF-8")
+}
+
+/// A directory under the temp dir holding the drop scene as `scene.json`.
+fn workdir(name: &str) -> (PathBuf, PathBuf, Vec<u8>) {
+    let dir = temp_path(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.json");
+    let text = scenes::drop().to_json().into_bytes();
+    std::fs::write(&scene, &text).unwrap();
+    (dir, scene, text)
+}
+
+/// The names in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}
+
+// ---------------------------------------------------------------------------
+// 1. No crash or memory blow-up from a flag
+// ---------------------------------------------------------------------------
+
+#[test]
+fn huge_counts_are_refused_before_anything_is_built() {
+    for args in [
+        &["run", "--builtin", "cubes", "--count", "4294967296", "--steps", "1"][..],
+        &["run", "--builtin", "pyramid", "--count", "100000", "--steps", "1"],
+        &["run", "--builtin", "cubes", "--count", "10000000", "--steps", "1"],
+        &["run", "--builtin", "ragdoll", "--count", "18446744073709551615", "--steps", "1"],
+        &["scene", "pyramid", "--count", "100000"],
+        &["scene", "cubes", "--count", "4294967296"],
+        &["scene", "blast", "--count", "18446744073709551615"],
+    ] {
+        assert_refused_quickly(args, &["--count", "1048576"]);
+    }
+    // the body count, worked out without building, is named
+    assert_refused_quickly(&["scene", "pyramid", "--count", "100000"], &["5000050000 bodies"]);
+    assert_refused_quickly(
+        &["bench", "--cases", "pyramid:100000", "--steps", "1", "--reps", "1", "--profile-steps", "0"],
+        &["--cases", "pyramid:100000", "5000050000"],
+    );
+}
+
+#[test]
+fn body_counts_are_worked_out_exactly_without_building() {
+    for &(name, _) in scenes::NAMES {
+        for count in [None, Some(1), Some(2), Some(3), Some(7), Some(30)] {
+            let Some(scene) = scenes::by_name(name, count, 1) else { panic!("{name}") };
+            assert_eq!(scenes::body_count(name, count), Some(scene.bodies.len() as u64), "{name} {count:?}");
+        }
+    }
+    assert_eq!(scenes::body_count("pyramid", Some(usize::MAX)), Some(u64::MAX / 2), "saturates");
+    assert_eq!(scenes::body_count("nonsense", Some(3)), None);
+}
+
+#[test]
+fn a_count_beyond_the_adapter_is_refused_before_the_scene_is_built() {
+    let Some(gpu) = common::gpu() else { return };
+    let max = verlet::world::max_bodies(&gpu);
+    let count = (max + 1).to_string();
+    let args = ["run", "--builtin", "chain", "--count", &count, "--steps", "1"];
+    let (out, took) = capped(&args);
+    assert_refused(&args, &out, &["--count", &count, &max.to_string(), "too large"]);
+    assert!(took < QUICK, "refused only after {took:?}");
+}
+
+#[test]
+fn built_in_scenes_refuse_counts_they_cannot_make() {
+    for (args, wanted) in [
+        (&["scene", "chain", "--count", "0"][..], "--count"),
+        (&["scene", "hanging", "--count", "1"], "--count"),
+        (&["scene", "cubes", "--count", "0"], "--count"),
+        (&["run", "--builtin", "bridge", "--count", "0", "--steps", "1"], "--count"),
+        (&["bench", "--cases", "chain:0"], "--cases"),
+    ] {
+        assert_refused_quickly(args, &[wanted]);
+    }
+    // what `verlet scene` prints, `verlet run` takes: every scene at its smallest count loads
+    for &(name, _) in scenes::NAMES {
+        let (out, _) = capped(&["scene", name, "--count", if name == "hanging" { "2" } else { "1" }]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        Scene::from_json_str(&String::from_utf8_lossy(&out.stdout)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+}
+
+// ---------------------------------------------------------------------------
+// 2. A user's files are never destroyed
+// ---------------------------------------------------------------------------
+
+#[test]
+fn outputs_that_are_inputs_or_each_other_are_refused() {
+    let (dir, scene, original) = workdir("clash");
+    let track = dir.join("track.json");
+    let track_text = br#"{"events": []}"#;
+    std::fs::write(&track, track_text).unwrap();
+    let dot_scene = format!("{}/./scene.json", s(&dir));
+    let out_csv = dir.join("out.csv");
+    let (sc, tr, oc) = (s(&scene), s(&track), s(&out_csv));
+    let before = listing(&dir);
+    for (args, wanted) in [
+        (vec!["run", sc, "--steps", "1", "--state-out", sc], vec!["--state-out", "scene file"]),
+        (vec!["run", sc, "--steps", "1", "--trace", &dot_scene], vec!["--trace", "scene file"]),
+        (vec!["run", sc, "--steps", "1", "--gif", sc], vec!["--gif", "scene file"]),
+        (vec!["run", sc, "--steps", "1", "--input", tr, "--trace", tr], vec!["--trace", "--input"]),
+        (vec!["run", sc, "--steps", "1", "--trace", oc, "--state-out", oc], vec!["--state-out", "--trace"]),
+        (vec!["run", sc, "--steps", "1", "--gif", oc, "--contact-sheet", oc], vec!["--contact-sheet", "--gif"]),
+        (vec!["bench", "--cases", "chain", "--json", oc, "--csv", oc], vec!["--csv", "--json"]),
+    ] {
+        assert_refused_quickly(&args, &wanted.iter().map(|w| &**w).collect::<Vec<_>>());
+        assert_eq!(std::fs::read(&scene).unwrap(), original, "{args:?}: the scene changed");
+        assert_eq!(std::fs::read(&track).unwrap(), track_text, "{args:?}: the track changed");
+        assert_eq!(listing(&dir), before, "{args:?}: files were left behind");
+    }
+    // a symbolic link to the scene is the scene
+    #[cfg(unix)]
+    {
+        let link = dir.join("link.json");
+        std::os::unix::fs::symlink(&scene, &link).unwrap();
+        assert_refused_quickly(&["run", sc, "--steps", "1", "--state-out", s(&link)], &["--state-out", "scene file"]);
+        assert_eq!(std::fs::read(&scene).unwrap(), original);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unusable_output_paths_are_refused_before_the_first_step() {
+    let (dir, _, _) = workdir("paths");
+    let file = dir.join("scene.json");
+    let inside_file = format!("{}/x.json", s(&file));
+    let missing = format!("{}/no/such/dir/x.json", s(&dir));
+    // a long run: refused at once, not after it
+    let long = ["run", "--builtin", "cubes", "--count", "1000", "--steps", "1000000"];
+    for (flag, path, why) in [
+        ("--state-out", missing.as_str(), "no directory"),
+        ("--trace", s(&dir), "directory"),
+        ("--gif", inside_file.as_str(), "no directory"),
+        ("--contact-sheet", missing.as_str(), "no directory"),
+    ] {
+        let mut args = long.to_vec();
+        args.extend([flag, path]);
+        assert_refused_quickly(&args, &[flag, path, why]);
+    }
+    for (flag, args) in [
+        ("--json", vec!["bench", "--cases", "chain", "--json", &missing]),
+        ("--csv", vec!["bench", "--cases", "chain", "--csv", s(&dir)]),
+    ] {
+        assert_refused_quickly(&args, &[flag]);
+        assert!(!Path::new(&missing).exists());
+    }
+    assert_eq!(listing(&dir), ["scene.json"], "nothing created");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
+    let (dir, _, _) = workdir("failed");
+    // body 1 of a row flies off at 2e5 m/s: the numerical fault stops the run
+    let mut scene = scenes::stack(0);
+    scene.bodies = (0..3).map(|k| scenes::box_body([0.5; 3], [10.0 * k as f32, 0.5, 0.0])).collect();
+    scene.bodies[1].linear_velocity = [0.0, 0.0, 2e5];
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, scene.to_json()).unwrap();
+    let (trace, state, frames) = (dir.join("trace.csv"), dir.join("state.json"), dir.join("frames"));
+    std::fs::write(&trace, "an old trace\n").unwrap();
+    std::fs::write(&state, "an old state\n").unwrap();
+    let args = [
+        "run", s(&bad), "--steps", "30", "--every", "10", "--trace", s(&trace), "--state-out", s(&state), "--frames",
+        s(&frames), "--width", "32", "--height", "24",
+    ];
+    let (out, _) = capped(&args);
+    if no_adapter(&out) {
+        return;
+    }
+    let err = stderr(&out);
+    assert_refused(&args, &out, &["body 1 became absurd"]);
+    assert_eq!(std::fs::read_to_string(&trace).unwrap(), "an old trace\n", "the old trace was replaced");
+    assert_eq!(std::fs::read_to_string(&state).unwrap(), "an old state\n", "the old state was replaced");
+    let partial = dir.join("trace.csv.partial");
+    let rows = std::fs::read_to_string(&partial).expect("the rows before the fault are kept");
+    assert!(rows.starts_with(verlet::output::TRACE_HEADER), "{rows}");
+    assert!(err.contains("note: --trace") && err.contains(s(&partial)), "{err}");
+    assert!(err.contains("note: --frames: 1 frames") && err.contains("note: --state-out"), "{err}");
+    // no half-written or temporary file anywhere
+    assert_eq!(listing(&dir), ["bad.json", "frames", "scene.json", "state.json", "trace.csv", "trace.csv.partial"]);
+    assert_eq!(listing(&frames), ["frame_000000.png"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_good_run_replaces_old_outputs_whole() {
+    let (dir, scene, original) = workdir("good");
+    let (trace, state) = (dir.join("trace.csv"), dir.join("state.json"));
+    std::fs::write(&trace, "an old trace\n").unwrap();
+    std::fs::write(&state, "an old state\n").unwrap();
+    let (out, _) = capped(&["run", s(&scene), "--steps", "4", "--every", "2", "--trace", s(&trace), "--state-out", s(&state)]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rows = std::fs::read_to_string(&trace).unwrap();
+    assert_eq!(rows.lines().count(), 1 + 3, "header and steps 0, 2, 4: {rows}");
+    let text = std::fs::read_to_string(&state).unwrap();
+    assert_eq!(serde_json::from_str::<serde_json::Value>(&text).unwrap()["step"], 4);
+    assert_eq!(std::fs::read(&scene).unwrap(), original);
+    assert_eq!(listing(&dir), ["scene.json", "state.json", "trace.csv"], "no temporary file left");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---------------------------------------------------------------------------
+// 3. Spin is checked
+// ---------------------------------------------------------------------------
+
+fn spinning(w: [f32; 3]) -> Scene {
+    let mut scene = scenes::drop();
+    scene.settings.gravity = [0.0; 3];
+    scene.bodies[0].angular_velocity = w;
+    scene
+}
+
+#[test]
+fn absurd_spins_are_refused_naming_the_field() {
+    let (dir, _, _) = workdir("spin");
+    for (w, why) in [([0.0, 1e30, 0.0], "rad/s"), ([2e4, 0.0, 0.0], "rad/s"), ([0.0, 0.0, 600.0], "substeps")] {
+        let mut scene = scenes::drop();
+        scene.bodies[0].angular_velocity = w;
+        // to_json writes what validation would refuse; the loader refuses it
+        let err = Scene::from_json_str(&scene.to_json()).unwrap_err().to_string();
+        assert!(err.contains("bodies[0].angular_velocity") && err.contains(why), "{w:?}: {err}");
+        let file = dir.join("spin.json");
+        std::fs::write(&file, scene.to_json()).unwrap();
+        assert_refused_quickly(&["run", s(&file), "--steps", "1"], &["bodies[0].angular_velocity"]);
+    }
+    // a spin a substep holds is fine; more substeps hold more
+    assert!(Scene::from_json_str(&spinning([0.0, 500.0, 0.0]).to_json()).is_ok());
+    let mut fast = spinning([0.0, 2000.0, 0.0]);
+    fast.settings.substeps = 16;
+    assert!(Scene::from_json_str(&fast.to_json()).is_ok());
+    // a track's set_velocity too
+    let track = dir.join("track.json");
+    std::fs::write(&track, r#"{"events": [{"t": 0, "set_velocity": {"body": 0, "angular": [0, 1e30, 0]}}]}"#).unwrap();
+    assert_refused_quickly(
+        &["run", "--builtin", "drop", "--steps", "1", "--input", s(&track)],
+        &["events[0].set_velocity.angular"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_summary_reports_speed_and_spin_apart() {
+    let (dir, _, _) = workdir("summary");
+    let file = dir.join("spin.json");
+    std::fs::write(&file, spinning([0.0, 212.0, 0.0]).to_json()).unwrap();
+    let (out, _) = capped(&["run", s(&file), "--steps", "10"]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().find(|l| l.contains("fastest spin")).unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("fastest body 0.000 m/s"), "{line}");
+    let spin: f32 = line.split("fastest spin ").nth(1).and_then(|r| r.split(' ').next()).unwrap().parse().unwrap();
+    assert!((spin - 212.0).abs() < 1.0, "{line}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_body_turning_more_than_a_substep_holds_is_faulted() {
+    use verlet::world::{Fault, FaultKind};
+    let mut scene = scenes::stack(0);
+    scene.settings.gravity = [0.0; 3];
+    scene.bodies = (0..3).map(|k| scenes::box_body([0.5; 3], [10.0 * k as f32, 5.0, 0.0])).collect();
+    let Some(mut world) = common::world(&scene) else { return };
+    world.step(2).unwrap();
+    // turn body 1's previous rotation 3.1 rad away from its current one
+    let mut state = world.read_raw().unwrap()[1];
+    let half = 3.1f32 / 2.0;
+    state.prev_rot = [0.0, half.sin(), 0.0, half.cos()];
+    state.rot = [0.0, 0.0, 0.0, 1.0];
+    let at = std::mem::size_of_val(&state) as u64;
+    world.gpu().queue.write_buffer(world.current_state_buffer(), at, bytemuck::bytes_of(&state));
+    world.step(3).unwrap();
+    let fault = world.faults().unwrap().expect("the spin is flagged");
+    assert_eq!(fault, Fault { body: 1, step: 2, kind: FaultKind::SpinsTooFast });
+    assert!(fault.to_string().contains("rad/s"), "{fault}");
+    // parked: it no longer turns
+    let after = world.read_raw().unwrap()[1];
+    let q = |a: [f32; 4]| glam::Quat::from_array(a);
+    assert!(q(after.rot).angle_between(q(after.prev_rot)) < 1e-3, "{after:?}");
+}
+
+// ---------------------------------------------------------------------------
+// 4. Clear errors everywhere
+// ---------------------------------------------------------------------------
+
+#[test]
+fn negative_numbers_are_refused_saying_what_the_flag_takes() {
+    for (flag, args) in [
+        ("--steps", vec!["run", "--builtin", "drop", "--steps", "-1"]),
+        ("--dt", vec!["run", "--builtin", "drop", "--steps", "1", "--dt", "-1"]),
+        ("--seed", vec!["run", "--builtin", "cubes", "--steps", "1", "--seed", "-1"]),
+        ("--count", vec!["run", "--builtin", "cubes", "--steps", "1", "--count", "-5"]),
+        ("--every", vec!["run", "--builtin", "drop", "--steps", "1", "--every", "-2"]),
+        ("--count", vec!["scene", "cubes", "--count", "-1"]),
+        ("--seed", vec!["scene", "cubes", "--seed", "-1"]),
+        ("--reps", vec!["bench", "--reps", "-1"]),
+        ("--steps", vec!["bench", "--steps", "-3"]),
+    ] {
+        let (out, took) = capped(&args);
+        assert_refused(&args, &out, &[flag, "-"]);
+        let line = reason(&out);
+        assert!(!line.contains("unexpected argument"), "{line}");
+        assert!(line.contains("must be"), "{args:?}: says not what the flag takes: {line}");
+        assert!(took < QUICK);
+    }
+    assert_refused_quickly(&["run", "--builtin", "drop", "--steps", "-1"], &["--steps: must be a non-negative whole number, got -1"]);
+}
+
+#[test]
+fn malformed_scene_files_are_named_with_the_line() {
+    let (dir, _, _) = workdir("malformed");
+    let bom = dir.join("bom.json");
+    std::fs::write(&bom, b"\xef\xbb\xbf{\"bodies\": []}").unwrap();
+    let empty = dir.join("empty.json");
+    std::fs::write(&empty, b"").unwrap();
+    for (file, why) in [(s(&bom), "byte-order mark"), (s(&empty), "is empty"), ("/dev/null", "is empty")] {
+        assert_refused_quickly(&["run", file, "--steps", "1"], &[file, "line 1", why]);
+    }
+    assert_refused_quickly(
+        &["run", "--builtin", "drop", "--steps", "1", "--input", s(&empty)],
+        &["--input", s(&empty), "line 1"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_scene_given_as_a_track_is_called_a_scene() {
+    let (dir, scene, original) = workdir("scene-as-track");
+    assert_refused_quickly(&["run", "--builtin", "drop", "--steps", "1", "--input", s(&scene)], &["--input", "scene"]);
+    assert_eq!(std::fs::read(&scene).unwrap(), original);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_bad_wgpu_backend_names_the_variable_and_its_values() {
+    for (var, value, valid) in [("WGPU_BACKEND", "nonsense", "vulkan"), ("WGPU_POWER_PREF", "fastest", "high")] {
+        let (out, took) = capped_env(&["info"], &[(var, value)]);
+        assert_refused(&["info"], &out, &[var, value, valid]);
+        assert!(!stderr(&out).contains("mesa-vulkan-drivers"), "{}", stderr(&out));
+        assert!(took < QUICK);
+    }
+}
+
+#[test]
+fn bench_says_aloud_what_it_skips() {
+    assert_refused_quickly(&["bench", "--cases", ",,,"], &["--cases", "no case"]);
+    let Some(gpu) = common::gpu() else { return };
+    let count = verlet::world::max_bodies(&gpu) + 1;
+    let case = format!("chain:{count}");
+    let (out, _) = capped(&["bench", "--cases", &format!("{case},,"), "--steps", "1", "--reps", "1", "--profile-steps", "0"]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning: --cases: 2 empty"), "{err}");
+    assert!(err.contains(&format!("warning: chain-{count}: does not fit, skipped")), "{err}");
+}
+
+#[test]
+fn track_events_after_the_last_step_are_warned_of() {
+    let (dir, _, _) = workdir("late");
+    let track = dir.join("track.json");
+    std::fs::write(&track, r#"{"events": [{"t": 0, "impulse": {"body": 0, "impulse": [0, 1, 0]}}, {"t": 100, "impulse": {"body": 0, "impulse": [0, 1, 0]}}]}"#)
+        .unwrap();
+    let (out, _) = capped(&["run", "--builtin", "drop", "--steps", "3", "--input", s(&track)]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("warning: --input: 1 of 2 events"), "{}", stderr(&out));
+    let _ = std::fs::remove_dir_all(&dir);
+}
