@@ -51,8 +51,8 @@ struct Params {
     _pad5: u32,
 }
 
-// A candidate pair found by the broadphase (pairs.wgsl): a < b, or b is
-// GROUND; `manifold` indexes the manifold pool, or NONE when the
+// A candidate pair found by the broadphase (pairs.wgsl): body a owns it; b
+// is another body or GROUND; `manifold` indexes the manifold pool, or NONE when the
 // narrowphase found no points. 12 bytes.
 struct Pair {
     a: u32,
@@ -80,9 +80,8 @@ struct ContactManifold {
 }
 
 // Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
-// how many pairs it owns (its partner has a higher index, or is the ground)
-// and is in, the prefix sums of both, the cursor its incoming pairs are
-// listed by, its wake flags (WOKEN_*), whether contacts can move it this
+// how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of
+// both, the cursor its incoming pairs are counted and listed by, its wake flags (WOKEN_*), whether contacts can move it this
 // step, and its bounds: the half extents of its world box grown by its
 // reach (how far it may move this step, m). The entry after the last body
 // holds the totals. 48 bytes.

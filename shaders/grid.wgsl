@@ -77,6 +77,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let reach = reach_of(i);
     let moves = !is_fixed(props[i]) && (!asleep(state_in[i]) || atomicLoad(&pair_meta[i].woken) != 0u);
     pair_meta[i].moves = u32(moves);
+    atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
     pair_meta[i].reach = reach;
     pair_meta[i].extent = world_extent(i) + vec3<f32>(reach);
     if (!in_grid(i)) {
@@ -97,7 +98,8 @@ fn scan_len() -> u32 {
 
 fn scan_read(k: u32) -> vec2<u32> {
     if (SCAN_PAIRS) {
-        return vec2<u32>(pair_meta[k].owned, pair_meta[k].total);
+        // owned, and all: owned plus those counted in by their owners
+        return vec2<u32>(pair_meta[k].owned, pair_meta[k].owned + atomicLoad(&pair_meta[k].cursor));
     }
     return vec2<u32>(atomicLoad(&cell_count[k]), 0u);
 }
@@ -146,6 +148,9 @@ fn scan_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
     scan_workgroup(lid.x);
     if (h < scan_len()) {
         scan_write(h, scan_tmp[lid.x] - v); // exclusive
+        if (SCAN_PAIRS) {
+            pair_meta[h].total = v.y;
+        }
     }
     if (lid.x == SCAN_BLOCK - 1u) {
         block_sums[wid.x] = scan_tmp[lid.x];
@@ -195,7 +200,10 @@ fn scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
     if (h < scan_len()) {
         scan_write(h, scan_start(h) + block_sums[h / SCAN_BLOCK]);
-        if (!SCAN_PAIRS) {
+        // the counts start again: pairs_write fills by them
+        if (SCAN_PAIRS) {
+            atomicStore(&pair_meta[h].cursor, 0u);
+        } else {
             atomicStore(&cell_count[h], 0u);
         }
     }

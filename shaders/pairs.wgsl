@@ -1,24 +1,30 @@
 // The pair list, once per step after the grid: every candidate pair once,
 // in an order that does not depend on thread timing.
 //
-//   pairs_count   bodies: walk the grid around the body; count the pairs it
-//                 owns (the partner's index is higher, or the partner is the
-//                 ground) and the pairs it is in
-//   scan_*        (grid.wgsl, SCAN_PAIRS) prefix sums of both counts, and the
-//                 narrowphase's indirect dispatch
+//   pairs_count   bodies: walk the grid around the body and the large
+//                 bodies; count the pairs it owns, and count each into its
+//                 partner's incoming pairs (pair_meta's cursor, an integer
+//                 atomic: the sum does not depend on the order)
+//   scan_*        (grid.wgsl, SCAN_PAIRS) prefix sums of the owned and of all
+//                 pairs, the narrowphase's indirect dispatch; the cursors
+//                 start again from 0
 //   pairs_write   bodies: walk again; write the owned pairs at the body's
 //                 offset, list each in both bodies' pair lists (an owned
 //                 pair at its rank, an incoming one by the partner's cursor)
 //   pairs_sort    bodies: sort the incoming part of the body's list by pair
 //                 index (the cursor's order depends on thread timing)
 //
-// A body's list is its incoming pairs (lower pair indices), then its owned
-// ones, so sorted it is in pair order: the solve sums in that order, the
-// same every run. A pair is wanted when its bounding spheres come within
-// the speculative margin, the two are not joined, and one of them moves:
-// not fixed and awake, or asleep but woken by the last step's narrowphase.
-// Both bodies of a pair decide alike (the test reads only what this pass
-// does not write), so counts and lists agree.
+// Who owns a pair (see `owns`): a grid body owns its pairs with grid bodies
+// of higher index and with every large body (it always walks them all); a
+// large body (kept out of the grid) owns only its pairs with large bodies
+// of higher index, so it never walks the cells; every body owns its pair
+// with the ground. A body's list is its incoming pairs sorted by pair index,
+// then its owned ones in the order its walk found them: the solve sums in
+// that order, the same every run. A pair is wanted when the two bodies'
+// bounds come within the margin, they are not joined, and one of them
+// moves: not fixed and awake, or asleep but woken by the last step's
+// narrowphase. Only the owner decides, alike in both walks (the test reads
+// only what these passes do not write).
 
 // Gap kept as contact whatever the speed (m).
 const CONTACT_MARGIN: f32 = 0.02;
@@ -42,7 +48,7 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
 
 // Whether bodies i and j (i != j) form a candidate pair: one of them moves,
 // their bounds (grown by their reach) come within CONTACT_MARGIN, and they
-// are not joined. Symmetric, and it reads only what grid_count wrote.
+// are not joined.
 fn wanted(i: u32, j: u32) -> bool {
     let lo = min(i, j);
     let hi = max(i, j);
@@ -64,15 +70,21 @@ fn wants_ground(i: u32) -> bool {
 var<private> self_index: u32;
 var<private> writing: bool;
 var<private> owned: u32;
-var<private> incoming: u32;
+
+// Whether body i owns its pair with body j (see the top of this file).
+fn owns(i: u32, j: u32) -> bool {
+    if (in_grid(i) != in_grid(j)) {
+        return in_grid(i);
+    }
+    return j > i;
+}
 
 // Lists owned pair number `owned` of this body: (a, b) = (self_index, j).
 fn write_owned(j: u32) {
     let i = self_index;
     let owned_start = pair_meta[i].owned_start;
     let p = owned_start + owned;
-    let list_incoming = pair_meta[i + 1u].list_start - pair_meta[i].list_start
-        - (pair_meta[i + 1u].owned_start - owned_start);
+    let list_incoming = pair_meta[i].total - pair_meta[i].owned;
     var entry = NONE;
     if (p < arrayLength(&pairs)) {
         pairs[p] = Pair(i, j, NONE);
@@ -94,17 +106,15 @@ fn list_put(k: u32, entry: u32) {
 
 fn visit(j: u32) {
     let i = self_index;
-    if (j == i || !wanted(i, j)) {
+    if (j == i || !owns(i, j) || !wanted(i, j)) {
         return;
     }
-    if (j > i) {
-        if (writing) {
-            write_owned(j);
-        }
-        owned = owned + 1u;
+    if (writing) {
+        write_owned(j);
     } else {
-        incoming = incoming + 1u;
+        atomicAdd(&pair_meta[j].cursor, 1u);
     }
+    owned = owned + 1u;
 }
 
 // Every body whose own cell is c (a bucket may also hold other cells).
@@ -119,34 +129,24 @@ fn visit_cell(c: vec3<i32>) {
     }
 }
 
-// Cells a large moving body scans, at most, per axis: beyond it the body
-// only meets the bodies of the cells nearest its centre.
-const MAX_SCAN_CELLS: i32 = 32;
-
-// The ground, then the grid cells around body i (for a body too large for
-// the grid, every cell its reach covers) and the large bodies.
+// The ground, then (for a body in the grid) the 27 grid cells around body
+// i, then the large bodies.
 fn walk(i: u32) {
     self_index = i;
     owned = 0u;
-    incoming = 0u;
     if (wants_ground(i)) {
         if (writing) {
             write_owned(GROUND);
         }
         owned = owned + 1u;
     }
-    let centre = state_in[i].pos.xyz;
-    var lo = cell_of(centre) - vec3<i32>(1);
-    var hi = cell_of(centre) + vec3<i32>(1);
-    if (!in_grid(i)) {
-        let r = pair_meta[i].extent + vec3<f32>(params.speculative);
-        lo = max(cell_of(centre - r), cell_of(centre) - vec3<i32>(MAX_SCAN_CELLS));
-        hi = min(cell_of(centre + r), cell_of(centre) + vec3<i32>(MAX_SCAN_CELLS));
-    }
-    for (var x = lo.x; x <= hi.x; x = x + 1) {
-        for (var y = lo.y; y <= hi.y; y = y + 1) {
-            for (var z = lo.z; z <= hi.z; z = z + 1) {
-                visit_cell(vec3<i32>(x, y, z));
+    if (in_grid(i)) {
+        let centre = cell_of(state_in[i].pos.xyz);
+        for (var x = -1; x <= 1; x = x + 1) {
+            for (var y = -1; y <= 1; y = y + 1) {
+                for (var z = -1; z <= 1; z = z + 1) {
+                    visit_cell(centre + vec3<i32>(x, y, z));
+                }
             }
         }
     }
@@ -164,8 +164,6 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     writing = false;
     walk(i);
     pair_meta[i].owned = owned;
-    pair_meta[i].total = owned + incoming;
-    atomicStore(&pair_meta[i].cursor, 0u);
 }
 
 @compute @workgroup_size(WORKGROUP)

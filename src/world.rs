@@ -232,8 +232,8 @@ impl ContactReport {
     }
 }
 
-/// Candidate pairs the list holds per body at first (pairs a body owns: its
-/// partner has a higher index, or is the ground). A settled pile of cubes
+/// Candidate pairs the list holds per body at first (pairs a body owns; see
+/// shaders/pairs.wgsl). A settled pile of cubes
 /// four deep owns about 2.5 (2.1 with other cubes, 0.4 with the ground,
 /// measured); both pools grow when a step fills half (`World::fit_pools`).
 pub const PAIRS_PER_BODY: u64 = 6;

@@ -81,8 +81,9 @@ pub struct Params {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Pair {
+    /// The body that owns the pair (shaders/pairs.wgsl).
     pub a: u32,
-    /// A body with a higher index than `a`, or `GROUND`.
+    /// Another body, or `GROUND`.
     pub b: u32,
     /// Index into the manifold pool, or `NONE`.
     pub manifold: u32,
