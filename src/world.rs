@@ -32,7 +32,8 @@ pub struct BodyOutput {
     pub asleep: bool,
 }
 
-/// The GPU buffers of a world. Nothing here is created after start-up.
+/// The GPU buffers of a world, made at start-up; only the pair list and the
+/// manifold pool are made again, larger, when a step fills half of either.
 struct WorldData {
     states: [wgpu::Buffer; 2],
     params: wgpu::Buffer,
