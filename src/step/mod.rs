@@ -102,9 +102,10 @@ impl Stage {
         self.name().starts_with("grid_")
     }
 
-    /// Whether the stage builds the pair list (`pairs_*`).
-    pub fn is_pair_list(self) -> bool {
-        self.name().starts_with("pairs_")
+    /// Whether the stage is one of grid.wgsl's scan passes run over the
+    /// bodies' pair counts (its override constant SCAN_PAIRS).
+    pub fn scans_pairs(self) -> bool {
+        matches!(self, Stage::PairsScanBlocks | Stage::PairsScanSums | Stage::PairsScanAdd)
     }
 
     /// Whether the pass writes state_out (so the current state flips).
@@ -174,7 +175,7 @@ impl StepPipelines {
             .iter()
             .map(|stage| {
                 let source = shaders::pass_source(stage.name()).expect("every stage has a shader");
-                let constants: &[(&str, f64)] = if stage.is_pair_list() { &[("SCAN_PAIRS", 1.0)] } else { &[] };
+                let constants: &[(&str, f64)] = if stage.scans_pairs() { &[("SCAN_PAIRS", 1.0)] } else { &[] };
                 let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some(stage.name()),
                     source: wgpu::ShaderSource::Wgsl(source.into()),
