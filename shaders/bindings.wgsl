@@ -11,14 +11,17 @@
 @group(0) @binding(6) var<storage, read_write> cell_start: array<u32>;          // hash_size + 1
 // the block totals of a prefix sum (grid.wgsl's scan): x for the grid, xy for the pairs
 @group(0) @binding(7) var<storage, read_write> block_sums: array<vec2<u32>>;
+// the grid's bodies sorted by cell, then (the last large_count entries,
+// written once when the world is made) the bodies kept out of the grid
 @group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // body_count
-@group(0) @binding(9) var<storage, read> large: array<u32>;                     // large_count
 // the pair pipeline (pairs.wgsl, narrowphase.wgsl): candidate pairs, each
 // found once; the manifold pool, filled by need; each body's pair list,
 // body i's at body_pairs[pair_meta[i].list_start ..][.. pair_meta[i].total],
 // sorted by pair index
 @group(0) @binding(10) var<storage, read_write> pairs: array<Pair>;             // pair capacity
 @group(0) @binding(11) var<storage, read_write> manifolds: array<ContactManifold>; // manifold capacity
+// what each manifold asks of its two bodies in a sweep (solve.wgsl, restitution.wgsl)
+@group(0) @binding(9) var<storage, read_write> snaps: array<ManifoldSnaps>;     // manifold capacity
 @group(0) @binding(15) var<storage, read_write> pair_meta: array<PairMeta>;     // body_count + 1
 @group(0) @binding(16) var<storage, read_write> body_pairs: array<u32>;         // 2 x pair capacity
 // status[0]: candidate pairs wanted this step, status[1]: most in any step;
@@ -28,8 +31,15 @@
 // lowest body found bad in the first step that found any, and that step's
 // step_index, both atomicMin-ed from NO_FAULT (0xffffffff, written when the
 // buffer is made); status[8..11]: the narrowphase's indirect dispatch
-// (workgroups over the pairs, 1, 1), copied out before it runs; 16 words
+// (workgroups over the pairs, 1, 1), copied out before it runs;
+// status[12..15]: the contact passes' (workgroups over the manifolds, 1, 1),
+// written by manifolds_dispatch and copied out after it; 16 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1
 @group(0) @binding(14) var<storage, read> joint_refs: array<JointRef>;          // 2 per joint
+
+// The k-th body kept out of the grid (its index).
+fn large_body(k: u32) -> u32 {
+    return sorted[params.body_count - params.large_count + k];
+}

@@ -61,30 +61,54 @@ struct Pair {
 }
 
 // One contact point of a pair: the point on each body in that body's own
-// frame (the ground's in world coordinates), and each body's normal push
-// summed over this substep's sweeps (m): its friction budget, written only
-// by that body's own solve and emptied by its restitution pass. 32 bytes.
+// frame (the ground's in world coordinates), and the normal push summed over
+// this substep's sweeps (m): its friction budget, written by the manifold's
+// solve_contacts invocation and emptied by restitution_contacts. 32 bytes.
 struct ContactPoint {
     local_a: vec3<f32>,
-    pushed_a: f32,
+    pushed: f32,
     local_b: vec3<f32>,
-    pushed_b: f32,
+    _pad0: f32,
 }
 
 // A pair's contact manifold, found once per step: up to MAX_POINTS points
-// sharing one world normal, pointing from a to b. 144 bytes.
+// sharing one world normal, pointing from a to b (GROUND or a body). 160 bytes.
 struct ContactManifold {
     normal: vec3<f32>,
     count: u32,
+    a: u32,
+    b: u32,
+    _pad0: u32,
+    _pad1: u32,
     points: array<ContactPoint, 4>,
+}
+
+// What one manifold asks of one of its bodies in a sweep, summed over its
+// points (solve_contacts, restitution_contacts): a move (m, or m/s in
+// restitution) and a turn (radians, or rad/s), world axes; `count`: 1 if
+// the manifold snapped the body (solve) or the points that acted
+// (restitution); `pressed`: 1 if a point has pushed in this substep. 32 bytes.
+struct EndSnap {
+    dx: vec3<f32>,
+    count: u32,
+    dtheta: vec3<f32>,
+    pressed: u32,
+}
+
+// Both ends' snaps of one manifold, at its index in the pool. 64 bytes.
+struct ManifoldSnaps {
+    a: EndSnap,
+    b: EndSnap,
 }
 
 // Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
 // how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of
-// both, the cursor its incoming pairs are counted and listed by, its wake flags (WOKEN_*), whether contacts can move it this
-// step, and its bounds: the half extents of its world box grown by its
-// reach (how far it may move this step, m). The entry after the last body
-// holds the totals. 48 bytes.
+// both, the cursor its incoming pairs are counted and listed by, its wake
+// flags (WOKEN_*), whether contacts can move it this step, how many of its
+// pairs have a manifold (contact_lists: its list then starts with their
+// contact references, see `contact_ref`), and its bounds: the half extents
+// of its world box grown by its reach (how far it may move this step, m).
+// The entry after the last body holds the totals. 48 bytes.
 struct PairMeta {
     owned: u32,
     total: u32,
@@ -93,7 +117,7 @@ struct PairMeta {
     cursor: atomic<u32>,
     woken: atomic<u32>,
     moves: u32,
-    _pad0: u32,
+    contacts: u32,
     extent: vec3<f32>,
     reach: f32,
 }
@@ -104,32 +128,24 @@ struct PairMeta {
 const WOKEN_NOW: u32 = 1u;
 const WOKEN_LAST: u32 = 2u;
 
+// A body's reference to one of its manifolds, as contact_lists leaves it in
+// the body's list: the manifold's index and which end of it the body is.
+fn contact_ref(manifold: u32, is_b: bool) -> u32 {
+    return 2u * manifold + u32(is_b);
+}
+
+// The snap manifold `r >> 1` asks of the body that holds reference r.
+fn snap_of(r: u32) -> EndSnap {
+    if ((r & 1u) != 0u) {
+        return snaps[r >> 1u].b;
+    }
+    return snaps[r >> 1u].a;
+}
+
 // Points a manifold holds (box-box manifolds are reduced to four).
 const MAX_POINTS: u32 = 4u;
 // No manifold / no pair.
 const NONE: u32 = 0xffffffffu;
-
-// One contact point as one body of its pair sees it (built on the fly from
-// the pair's manifold, never stored): the point on this body and on its
-// partner, each in its owner's frame (the ground's in world coordinates),
-// this body's push so far, and the world normal along which this body is
-// pushed out.
-struct Contact {
-    local_self: vec3<f32>,
-    partner: u32,            // body index, or GROUND
-    local_partner: vec3<f32>,
-    pushed: f32,
-    normal: vec3<f32>,
-}
-
-// Point pt of pair pr's manifold (whose normal, a to b, is `normal`) as
-// body `self_is_a ? a : b` sees it.
-fn contact_view(pr: Pair, normal: vec3<f32>, pt: ContactPoint, self_is_a: bool) -> Contact {
-    if (self_is_a) {
-        return Contact(pt.local_a, pr.b, pt.local_b, pt.pushed_a, -normal);
-    }
-    return Contact(pt.local_b, pr.a, pt.local_a, pt.pushed_b, normal);
-}
 
 // Fastest speed (m/s) at which the solve pushes apart bodies that already
 // overlapped at their previous poses (Box2D's contact push speed is 3 m/s).
@@ -250,23 +266,6 @@ fn effective_inv_mass(p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>
     return p.inv_inertia.w + dot(rn, inv_inertia_world(rot, p.inv_inertia.xyz, rn));
 }
 
-// The partner's side of a contact at its current pose: its contact point and
-// that point's position at its previous pose. The ground never moves.
-struct PartnerPoint {
-    r: vec3<f32>,      // offset from the partner's centre (zero for the ground)
-    point: vec3<f32>,  // world
-    before: vec3<f32>, // world, at the previous pose
-}
-
-fn partner_point(c: Contact) -> PartnerPoint {
-    if (c.partner == GROUND) {
-        return PartnerPoint(vec3<f32>(0.0), c.local_partner, c.local_partner);
-    }
-    let o = state_in[c.partner];
-    let r = quat_rotate(o.rot, c.local_partner);
-    return PartnerPoint(r, o.pos.xyz + r, o.prev_pos.xyz + quat_rotate(o.prev_rot, c.local_partner));
-}
-
 // Sleeping (settings.sleeping; the paper has none). A body that has been
 // slower than SLEEP_SPEED while touching something for params.sleep_after
 // seconds sleeps: integrate holds it still, without gravity, the solve and
@@ -298,32 +297,58 @@ fn point_speed(s: BodyState, p: BodyProps) -> f32 {
     return (length(s.pos.xyz - s.prev_pos.xyz) + spin * p.half_extents.w) / params.dt_prev;
 }
 
-// Whether a contact's partner can be moved by it: not the ground, not asleep.
-fn partner_moves(c: Contact) -> bool {
-    return c.partner != GROUND && !asleep(state_in[c.partner]);
+// One body of a contact manifold as the contact passes see it: its poses,
+// masses and material; the ground is an end at the origin with no mass.
+struct ContactEnd {
+    pos: vec3<f32>,
+    prev_pos: vec3<f32>,
+    rot: vec4<f32>,
+    prev_rot: vec4<f32>,
+    inv_inertia: vec4<f32>, // xyz body frame (1/(kg m^2)); w = inverse mass (1/kg)
+    moves: bool,            // awake and not fixed: the contacts may move it
+    restitution: f32,
+    friction: f32,
 }
 
-// The partner's generalised inverse mass along dir (0 unless it moves).
-fn partner_inv_mass(c: Contact, r: vec3<f32>, dir: vec3<f32>) -> f32 {
-    if (!partner_moves(c)) {
+fn contact_end(i: u32) -> ContactEnd {
+    if (i == GROUND) {
+        let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), false,
+                          params.ground_restitution, params.ground_friction);
+    }
+    let s = state_in[i];
+    let p = props[i];
+    return ContactEnd(s.pos.xyz, s.prev_pos.xyz, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
+                      p.material.x, p.material.y);
+}
+
+// Generalised inverse mass of an end for a unit push along dir at offset r;
+// 0 for an end the contacts may not move (the ground, fixed, asleep).
+fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
+    if (!e.moves) {
         return 0.0;
     }
-    return effective_inv_mass(props[c.partner], state_in[c.partner].rot, r, dir);
+    let rn = cross(r, dir);
+    return e.inv_inertia.w + dot(rn, inv_inertia_world(e.rot, e.inv_inertia.xyz, rn));
+}
+
+// What a summed impulse-like vector j (through points at summed moments
+// `moment` = sum of r x j) asks of an end: its inverse mass times j, its
+// world inverse inertia times the moment (nothing for an end that stays).
+fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, pressed: u32) -> EndSnap {
+    if (!e.moves) {
+        return EndSnap(vec3<f32>(0.0), 0u, vec3<f32>(0.0), pressed);
+    }
+    return EndSnap(j * e.inv_inertia.w, count, inv_inertia_world(e.rot, e.inv_inertia.xyz, moment), pressed);
 }
 
 // Restitution and friction of a contact: the larger restitution and the
 // geometric mean of the frictions (Box2D's rule); the ground's material is
 // settings.restitution and settings.friction.
-fn combined_restitution(p: BodyProps, c: Contact) -> f32 {
-    if (c.partner == GROUND) {
-        return max(p.material.x, params.ground_restitution);
-    }
-    return max(p.material.x, props[c.partner].material.x);
+fn combined_restitution(a: ContactEnd, b: ContactEnd) -> f32 {
+    return max(a.restitution, b.restitution);
 }
 
-fn combined_friction(p: BodyProps, c: Contact) -> f32 {
-    if (c.partner == GROUND) {
-        return sqrt(p.material.y * params.ground_friction);
-    }
-    return sqrt(p.material.y * props[c.partner].material.y);
+fn combined_friction(a: ContactEnd, b: ContactEnd) -> f32 {
+    return sqrt(a.friction * b.friction);
 }

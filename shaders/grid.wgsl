@@ -11,7 +11,7 @@
 //   grid_scatter      bodies:  sorted[cell_start + count++] = body
 //   grid_sort         buckets: sort each bucket's bodies by index (determinism)
 //
-// Bodies in large[] (much bigger than a cell) are not in the grid.
+// Large bodies (much bigger than a cell; large_body()) are not in the grid.
 //
 // The three scan passes serve the pair pipeline too (pairs.wgsl): with the
 // override constant SCAN_PAIRS they sum the bodies' pair counts instead

@@ -105,6 +105,8 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
             var stored: ContactManifold;
             stored.normal = m.normal;
             stored.count = m.count;
+            stored.a = pr.a;
+            stored.b = pr.b;
             var deepest = 3.4e38;
             for (var k = 0u; k < MAX_POINTS; k = k + 1u) {
                 if (k < m.count) {
@@ -126,4 +128,39 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     pairs[p].manifold = slot;
+}
+
+// Pass "contact_lists", once after the narrowphase, one invocation per body:
+// the body's pairs that have a manifold, in list order, become the first
+// entries of its list as contact references (contact_ref; the solve and
+// restitution walk only these), counted in pair_meta's `contacts`.
+// Invocation 0 also writes the contact passes' indirect dispatch, over the
+// manifolds the pool holds (status[12..15]).
+@compute @workgroup_size(WORKGROUP)
+fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i == 0u) {
+        let used = min(atomicLoad(&status[4]), arrayLength(&manifolds));
+        atomicStore(&status[12], (used + WORKGROUP - 1u) / WORKGROUP);
+        atomicStore(&status[13], 1u);
+        atomicStore(&status[14], 1u);
+    }
+    if (i >= params.body_count) {
+        return;
+    }
+    let first = pair_meta[i].list_start;
+    let end = min(first + pair_meta[i].total, arrayLength(&body_pairs));
+    var out = first;
+    for (var e = first; e < end; e = e + 1u) {
+        let q = body_pairs[e];
+        if (q == NONE) {
+            continue;
+        }
+        let pr = pairs[q];
+        if (pr.manifold != NONE) {
+            body_pairs[out] = contact_ref(pr.manifold, pr.a != i);
+            out = out + 1u;
+        }
+    }
+    pair_meta[i].contacts = out - first;
 }

@@ -1,8 +1,8 @@
 // The pair list, once per step after the grid: every candidate pair once,
 // in an order that does not depend on thread timing.
 //
-//   pairs_count   bodies: walk the grid around the body and the large
-//                 bodies; count the pairs it owns, and count each into its
+//   pairs_count   bodies: walk the body's own grid cell and the 13 cells
+//                 ahead of it, and the large bodies; count the pairs it owns, and count each into its
 //                 partner's incoming pairs (pair_meta's cursor, an integer
 //                 atomic: the sum does not depend on the order)
 //   scan_*        (grid.wgsl, SCAN_PAIRS) prefix sums of the owned and of all
@@ -14,11 +14,14 @@
 //   pairs_sort    bodies: sort the incoming part of the body's list by pair
 //                 index (the cursor's order depends on thread timing)
 //
-// Who owns a pair (see `owns`): a grid body owns its pairs with grid bodies
-// of higher index and with every large body (it always walks them all); a
-// large body (kept out of the grid) owns only its pairs with large bodies
-// of higher index, so it never walks the cells; every body owns its pair
-// with the ground. A body's list is its incoming pairs sorted by pair index,
+// Who owns a pair (see `walk`): of two grid bodies in neighbouring cells,
+// the one whose cell is behind the other's (the other's cell is among its
+// 13 cells ahead: +x, or the same x and +y, or the same x and y and +z), so
+// each walk visits half the neighbourhood; of two in one cell, the lower
+// index. A grid body owns its pairs with every large body (it always walks
+// them all); a large body (kept out of the grid) owns only its pairs with
+// large bodies of higher index, so it never walks the cells; every body
+// owns its pair with the ground. A body's list is its incoming pairs sorted by pair index,
 // then its owned ones in the order its walk found them: the solve sums in
 // that order, the same every run. A pair is wanted when the two bodies'
 // bounds come within the margin, they are not joined, and one of them
@@ -47,16 +50,21 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
 }
 
 // Whether bodies i and j (i != j) form a candidate pair: one of them moves,
-// their bounds (grown by their reach) come within CONTACT_MARGIN, and they
-// are not joined.
+// their bounds (world boxes and bounding spheres, grown by their reach)
+// come within CONTACT_MARGIN, and they are not joined. The spheres cut the
+// corners of the boxes: of the pairs of tumbling cubes in a falling pile
+// whose boxes meet, about a third are further apart than their spheres.
 fn wanted(i: u32, j: u32) -> bool {
     let lo = min(i, j);
     let hi = max(i, j);
     if (pair_meta[lo].moves == 0u && pair_meta[hi].moves == 0u) {
         return false;
     }
-    let apart = abs(state_in[lo].pos.xyz - state_in[hi].pos.xyz) - pair_meta[lo].extent - pair_meta[hi].extent;
-    return all(apart <= vec3<f32>(CONTACT_MARGIN)) && !joined(lo, hi);
+    let d = state_in[lo].pos.xyz - state_in[hi].pos.xyz;
+    let apart = abs(d) - pair_meta[lo].extent - pair_meta[hi].extent;
+    let reach = pair_meta[lo].reach + pair_meta[hi].reach;
+    let spheres = props[lo].half_extents.w + props[hi].half_extents.w + reach + CONTACT_MARGIN;
+    return all(apart <= vec3<f32>(CONTACT_MARGIN)) && dot(d, d) <= spheres * spheres && !joined(lo, hi);
 }
 
 // Whether body i is near enough the ground for a ground pair.
@@ -70,14 +78,6 @@ fn wants_ground(i: u32) -> bool {
 var<private> self_index: u32;
 var<private> writing: bool;
 var<private> owned: u32;
-
-// Whether body i owns its pair with body j (see the top of this file).
-fn owns(i: u32, j: u32) -> bool {
-    if (in_grid(i) != in_grid(j)) {
-        return in_grid(i);
-    }
-    return j > i;
-}
 
 // Lists owned pair number `owned` of this body: (a, b) = (self_index, j).
 fn write_owned(j: u32) {
@@ -104,9 +104,10 @@ fn list_put(k: u32, entry: u32) {
     }
 }
 
+// Body j, whose pair with this body the walk owns.
 fn visit(j: u32) {
     let i = self_index;
-    if (j == i || !owns(i, j) || !wanted(i, j)) {
+    if (!wanted(i, j)) {
         return;
     }
     if (writing) {
@@ -117,20 +118,21 @@ fn visit(j: u32) {
     owned = owned + 1u;
 }
 
-// Every body whose own cell is c (a bucket may also hold other cells).
-fn visit_cell(c: vec3<i32>) {
+// Every body whose own cell is c (a bucket may also hold other cells) and
+// whose index is above `above` (the walker's own cell; NONE: every body).
+fn visit_cell(c: vec3<i32>, above: u32) {
     let h = bucket_of(c);
     let end = cell_start[h + 1u];
     for (var k = cell_start[h]; k < end; k = k + 1u) {
         let j = sorted[k];
-        if (all(cell_of(state_in[j].pos.xyz) == c)) {
+        if ((above == NONE || j > above) && all(cell_of(state_in[j].pos.xyz) == c)) {
             visit(j);
         }
     }
 }
 
-// The ground, then (for a body in the grid) the 27 grid cells around body
-// i, then the large bodies.
+// The ground, then (for a body in the grid) its own cell and the 13 cells
+// ahead of it, then the large bodies it owns pairs with.
 fn walk(i: u32) {
     self_index = i;
     owned = 0u;
@@ -140,18 +142,25 @@ fn walk(i: u32) {
         }
         owned = owned + 1u;
     }
-    if (in_grid(i)) {
+    let grid = in_grid(i);
+    if (grid) {
         let centre = cell_of(state_in[i].pos.xyz);
-        for (var x = -1; x <= 1; x = x + 1) {
-            for (var y = -1; y <= 1; y = y + 1) {
-                for (var z = -1; z <= 1; z = z + 1) {
-                    visit_cell(centre + vec3<i32>(x, y, z));
-                }
+        visit_cell(centre, i);
+        for (var y = -1; y <= 1; y = y + 1) {
+            for (var z = -1; z <= 1; z = z + 1) {
+                visit_cell(centre + vec3<i32>(1, y, z), NONE);
             }
         }
+        for (var z = -1; z <= 1; z = z + 1) {
+            visit_cell(centre + vec3<i32>(0, 1, z), NONE);
+        }
+        visit_cell(centre + vec3<i32>(0, 0, 1), NONE);
     }
     for (var k = 0u; k < params.large_count; k = k + 1u) {
-        visit(large[k]);
+        let j = large_body(k);
+        if (grid || j > i) {
+            visit(j);
+        }
     }
 }
 

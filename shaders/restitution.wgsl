@@ -1,5 +1,5 @@
-// Pass "restitution", once per substep after the solve: collisions change
-// velocity by rewriting the previous pose (the paper, section III). A contact
+// Passes "restitution_contacts" and "restitution", once per substep after
+// the solve: collisions change velocity by rewriting the previous pose (the paper, section III). A contact
 // that was approaching faster than a resting contact can (2 |g| dt), and
 // faster than RESTITUTION_THRESHOLD, leaves with -e times its approach speed
 // along the normal; slower ones stay at rest, so resting bodies do not hop.
@@ -8,21 +8,113 @@
 // pumped energy in (a ragdoll's forearm jittered forever). Dynamic friction acts here too: a
 // contact still sliding after the solve loses up to mu times the normal
 // velocity change its push made (mu |dv_n|, Coulomb's law per substep).
-// Every contact is measured on the velocities after the solve and the
-// changes summed, the turns split among the contacts as in the solve.
+// Every contact is measured on the velocities after the solve, once per
+// manifold (restitution_contacts, which writes what it asks of each body to
+// snaps[manifold] and empties its points' friction budgets); each body sums
+// what its manifolds ask (restitution), the turns split among the contacts
+// that acted as in the solve.
 
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
 
 // Velocities a pose implies: (x - x_prev) / dt and the rotation q q_prev^*.
-fn implied_velocity(s: BodyState) -> Velocity {
-    let v = (s.pos.xyz - s.prev_pos.xyz) / params.dt;
-    let w = quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))) / params.dt;
+fn pose_velocity(pos: vec3<f32>, prev_pos: vec3<f32>, rot: vec4<f32>, prev_rot: vec4<f32>) -> Velocity {
+    let v = (pos - prev_pos) / params.dt;
+    let w = quat_to_rotvec(quat_mul(rot, quat_conj(prev_rot))) / params.dt;
     return Velocity(vec4<f32>(v, 0.0), vec4<f32>(w, 0.0));
 }
 
 fn point_velocity(v: Velocity, r: vec3<f32>) -> vec3<f32> {
     return v.linear.xyz + cross(v.angular.xyz, r);
+}
+
+// The velocities of a contact's end after the solve: zero for the ground.
+fn end_velocity(i: u32, e: ContactEnd) -> Velocity {
+    if (i == GROUND) {
+        return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
+    }
+    return pose_velocity(e.pos, e.prev_pos, e.rot, e.prev_rot);
+}
+
+// ... and before it (integrate's vel0).
+fn end_velocity_before(i: u32) -> Velocity {
+    if (i == GROUND) {
+        return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
+    }
+    return vel0[i];
+}
+
+@compute @workgroup_size(WORKGROUP)
+fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= min(atomicLoad(&status[4]), arrayLength(&manifolds))) {
+        return;
+    }
+    let a = manifolds[k].a;
+    let b = manifolds[k].b;
+    let ea = contact_end(a);
+    let eb = contact_end(b);
+    let n = manifolds[k].normal; // from a to b
+    let count = manifolds[k].count;
+    if (!ea.moves && !eb.moves) {
+        for (var q = 0u; q < count; q = q + 1u) {
+            manifolds[k].points[q].pushed = 0.0;
+        }
+        return;
+    }
+    let va0 = end_velocity_before(a);
+    let vb0 = end_velocity_before(b);
+    let va = end_velocity(a, ea);
+    let vb = end_velocity(b, eb);
+    let threshold = max(2.0 * length(params.gravity.xyz) * params.dt, RESTITUTION_THRESHOLD);
+    let mu = combined_friction(ea, eb);
+    let e = combined_restitution(ea, eb);
+    // summed over the points: the velocity change asked of b (a gets the
+    // opposite), times the inverse masses later, and its moments
+    var j = vec3<f32>(0.0);
+    var moment_a = vec3<f32>(0.0);
+    var moment_b = vec3<f32>(0.0);
+    var acting = 0u;
+    for (var q = 0u; q < count; q = q + 1u) {
+        let pt = manifolds[k].points[q];
+        manifolds[k].points[q].pushed = 0.0;
+        let ra = quat_rotate(ea.rot, pt.local_a);
+        let rb = quat_rotate(eb.rot, pt.local_b);
+        // touching?
+        if (dot((eb.pos + rb) - (ea.pos + ra), n) > CONTACT_SLOP) {
+            continue;
+        }
+        // velocity of a's point relative to b's after the solve, and the
+        // approach speed along n before it
+        let relative_now = point_velocity(va, ra) - point_velocity(vb, rb);
+        let approach = -dot(point_velocity(va0, ra) - point_velocity(vb0, rb), n);
+        var impulse = vec3<f32>(0.0);
+        var acted = false;
+        // dynamic friction against the sliding left after the solve
+        let v_t = relative_now - n * dot(relative_now, n);
+        let sliding = length(v_t);
+        if (pt.pushed > 0.0 && sliding > 1e-6) {
+            let t = v_t / sliding;
+            let cut = min(mu * pt.pushed / params.dt, sliding);
+            impulse = impulse + t * (cut / (end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t)));
+            acted = true;
+        }
+        // restitution of a fast approach (approach < 0: closing), both
+        // speeds along a's push direction -n
+        let vn = -dot(relative_now, n);
+        let target_vn = -e * approach;
+        if (approach < -threshold && vn < target_vn) {
+            impulse = impulse + n * ((target_vn - vn) / (end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n)));
+            acted = true;
+        }
+        if (acted) {
+            j = j + impulse;
+            moment_a = moment_a + cross(ra, impulse);
+            moment_b = moment_b + cross(rb, impulse);
+            acting = acting + 1u;
+        }
+    }
+    snaps[k] = ManifoldSnaps(end_snap(ea, -j, -moment_a, acting, 0u), end_snap(eb, j, moment_b, acting, 0u));
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -34,83 +126,24 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state_in[i];
     let p = props[i];
     let first = pair_meta[i].list_start;
-    let end = min(first + pair_meta[i].total, arrayLength(&body_pairs));
+    let end = first + pair_meta[i].contacts;
     if (is_fixed(p) || first == end || asleep(s)) {
         state_out[i] = s;
         return;
     }
-    let before = vel0[i];
-    let now = implied_velocity(s);
-    let threshold = max(2.0 * length(params.gravity.xyz) * params.dt, RESTITUTION_THRESHOLD);
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
-    // the body's pairs in pair order (pairs.wgsl); each point's friction
-    // budget is emptied for the next substep once it has been used here
+    // the body's manifolds in pair order (contact_lists)
     for (var e = first; e < end; e = e + 1u) {
-        let q = body_pairs[e];
-        if (q == NONE || pairs[q].manifold == NONE) {
-            continue;
-        }
-        let pr = pairs[q];
-        let self_is_a = pr.a == i;
-        let normal = manifolds[pr.manifold].normal;
-        // the partner's velocities before the solve and now, once per pair
-        let partner = select(pr.a, pr.b, self_is_a);
-        var partner_v0 = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
-        var partner_v = partner_v0;
-        if (partner != GROUND) {
-            partner_v0 = vel0[partner];
-            partner_v = implied_velocity(state_in[partner]);
-        }
-        for (var k = 0u; k < manifolds[pr.manifold].count; k = k + 1u) {
-            let c = contact_view(pr, normal, manifolds[pr.manifold].points[k], self_is_a);
-            if (self_is_a) {
-                manifolds[pr.manifold].points[k].pushed_a = 0.0;
-            } else {
-                manifolds[pr.manifold].points[k].pushed_b = 0.0;
-            }
-            let o = partner_point(c);
-            let n = c.normal;
-            let r = quat_rotate(s.rot, c.local_self);
-            // touching?
-            if (dot((s.pos.xyz + r) - o.point, n) > CONTACT_SLOP) {
-                continue;
-            }
-            // approach speed of the two points before the solve, and now
-            let partner_before = point_velocity(partner_v0, o.r);
-            let partner_now = point_velocity(partner_v, o.r);
-            let relative_now = point_velocity(now, r) - partner_now;
-            let w_self_n = effective_inv_mass(p, s.rot, r, n);
-            var acted = false;
-            // dynamic friction against the sliding left after the solve
-            let v_t = relative_now - n * dot(relative_now, n);
-            let sliding = length(v_t);
-            if (c.pushed > 0.0 && sliding > 1e-6) {
-                let t = v_t / sliding;
-                let cut = min(combined_friction(p, c) * c.pushed / params.dt, sliding);
-                let lambda_t = cut / (effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t));
-                dv = dv - t * (p.inv_inertia.w * lambda_t);
-                dw = dw - inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, t)) * lambda_t;
-                acted = true;
-            }
-            // restitution of a fast approach
-            let approach = dot(point_velocity(before, r) - partner_before, n);
-            let vn = dot(relative_now, n);
-            let target_vn = -combined_restitution(p, c) * approach;
-            if (approach < -threshold && vn < target_vn) {
-                let lambda = (target_vn - vn) / (w_self_n + partner_inv_mass(c, o.r, n));
-                dv = dv + n * (p.inv_inertia.w * lambda);
-                dw = dw + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * lambda;
-                acted = true;
-            }
-            if (acted) {
-                acting = acting + 1u;
-            }
-        }
+        let snap = snap_of(body_pairs[e]);
+        dv = dv + snap.dx;
+        dw = dw + snap.dtheta;
+        acting = acting + snap.count;
     }
     dw = dw / f32(max(acting, 1u));
     if (any(dv != vec3<f32>(0.0)) || any(dw != vec3<f32>(0.0))) {
+        let now = pose_velocity(s.pos.xyz, s.prev_pos.xyz, s.rot, s.prev_rot);
         let v = now.linear.xyz + dv;
         let w = now.angular.xyz + dw;
         s.prev_pos = vec4<f32>(s.pos.xyz - v * params.dt, s.prev_pos.w);

@@ -1,27 +1,18 @@
-// Pass "solve", run `iterations` times per substep: the paper's corrective
-// snaps (eqs. 9-10). Each body reads every pose from state_in and writes only
-// its own slot of state_out and of its own contacts. All of a body's
-// contacts are measured on the same starting pose and their snaps summed
-// (Jacobi within the body as across bodies), so symmetric contacts (a box
-// resting on four corners) cancel exactly instead of twisting the body in
-// the order they were visited; the sum is then relaxed by c_r (eq. 10).
+// Passes "solve_contacts" and "solve", run in turn `iterations` times per
+// substep: the paper's corrective snaps (eqs. 9-10), Jacobi style. Every
+// pose is read from state_in: solve_contacts, one invocation per manifold of
+// the pool, measures all of a pair's points once and writes what they ask of
+// each of its two bodies (snaps[manifold]); solve, one invocation per body,
+// sums what its manifolds and joints ask, relaxes the sum by c_r (eq. 10)
+// and writes only its own slot of state_out. All of a body's snaps are
+// measured on the same starting pose and summed, so symmetric contacts (a
+// box resting on four corners) cancel exactly instead of twisting the body
+// in the order they were visited, and the sums never depend on thread timing.
 
 // A snap being summed: translation and rotation (radians, world axes).
 struct Snap {
     dx: vec3<f32>,
     dtheta: vec3<f32>,
-}
-
-// What one partner's points ask for, kept apart until the partner's last
-// point so that it can be scaled and averaged as a whole (see `flush`).
-struct PartnerSum {
-    normal_dx: vec3<f32>,   // summed translation of the normal snaps
-    normal_inv_w: f32,      // sum over those points of 1 / (w_self + w_partner)
-    friction_dx: vec3<f32>, // summed translation of the static-friction snaps
-    friction_inv_w: f32,
-    pair_w: f32,            // inverse masses of the two bodies, summed
-    dtheta: vec3<f32>,      // summed rotation of the points' snaps
-    points: u32,            // points that snapped
 }
 
 // Add a push of lambda along dir at offset r: translation along dir, rotation
@@ -31,68 +22,112 @@ fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>
     (*acc).dtheta = (*acc).dtheta + inv_inertia_world(rot, p.inv_inertia.xyz, cross(r, dir)) * lambda;
 }
 
-// One contact: the normal snap takes this body's share of the depth,
-// w_self / (w_self + w_partner), the partner the rest in its own thread.
+// One manifold's points, on the poses of state_in. For each point, the
+// normal snap closes the depth, shared by the two bodies by their inverse
+// masses (w_a + w_b, where a body the contacts may not move counts 0).
 // Static friction (as XPBD has it): if the two material points have slid
 // apart since their previous poses by less than mu times the normal push
 // summed over this substep, the slide is undone; a larger slide is left to
-// dynamic friction in the restitution pass. The snaps are added to the
-// partner's sum `m`. Returns the push (m).
-fn add_contact(m: ptr<function, PartnerSum>, s: BodyState, p: BodyProps, c: Contact) -> f32 {
-    let o = partner_point(c);
-    let n = c.normal;
-    let r = quat_rotate(s.rot, c.local_self);
-    let self_before = s.prev_pos.xyz + quat_rotate(s.prev_rot, c.local_self);
-    // Overlap the bodies already had at their previous poses is pushed out at
-    // no more than MAX_DEPENETRATION_SPEED: a full snap in one substep would
-    // turn into that much velocity (Verlet), and deep overlaps (thin limbs
-    // passing through each other, bodies placed overlapping) launched bodies
-    // at tens of m/s. Overlap made by this substep's approach is removed whole.
-    let overlap_before = dot(o.before - self_before, n);
-    let depth = dot(o.point - (s.pos.xyz + r), n) - max(overlap_before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
-    // a contact that pushed earlier in this substep keeps its friction while
-    // it still touches, even once its depth is resolved, so sideways pushes
-    // from other contacts in later iterations are resisted too
-    var push = 0.0;
-    if (depth > 0.0) {
-        let w = effective_inv_mass(p, s.rot, r, n) + partner_inv_mass(c, o.r, n);
-        (*m).dtheta = (*m).dtheta + inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, n)) * (depth / w);
-        (*m).normal_dx = (*m).normal_dx + n * (p.inv_inertia.w * depth / w);
-        (*m).normal_inv_w = (*m).normal_inv_w + 1.0 / w;
-        push = depth * params.relaxation;
-    } else if (c.pushed <= 0.0 || depth < -CONTACT_SLOP) {
-        return 0.0;
+// dynamic friction in the restitution pass.
+//
+// Each point's snap moves the bodies as if that point were alone; when
+// several points of one face all ask for the same depth d, their sum is
+// d x (pair_w x the sum of 1/w), which is d for points at the corners of a
+// cube but four times d for points near the middle of a large face (a box
+// resting across two others): that overshoot made piles vibrate and walk
+// apart. The sum is scaled down to what moving the two bodies apart without
+// turning asks for, never up. The points' turns are averaged: each was
+// computed as if it alone turned the body.
+@compute @workgroup_size(WORKGROUP)
+fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= min(atomicLoad(&status[4]), arrayLength(&manifolds))) {
+        return;
     }
-    let slip = (s.pos.xyz + r) - self_before - (o.point - o.before);
-    let slip_t = slip - n * dot(slip, n);
-    let slide = length(slip_t);
-    if (slide > 1e-9 && slide <= combined_friction(p, c) * (c.pushed + push)) {
-        let t = slip_t / slide;
-        let w = effective_inv_mass(p, s.rot, r, t) + partner_inv_mass(c, o.r, t);
-        (*m).dtheta = (*m).dtheta - inv_inertia_world(s.rot, p.inv_inertia.xyz, cross(r, t)) * (slide / w);
-        (*m).friction_dx = (*m).friction_dx - t * (p.inv_inertia.w * slide / w);
-        (*m).friction_inv_w = (*m).friction_inv_w + 1.0 / w;
+    let ea = contact_end(manifolds[k].a);
+    let eb = contact_end(manifolds[k].b);
+    if (!ea.moves && !eb.moves) {
+        return; // neither body reads its snap
     }
-    return push;
-}
-
-// Adds one partner's snaps to the body's and empties `m`; returns 1 if the
-// partner pushed at all. Each point's snap moves the body as if that point
-// were alone; when several points of one face all ask for the same depth d,
-// their sum is d x (pair_w x the sum of 1/w), which is d for points at the
-// corners of a cube but four times d for points near the middle of a large
-// face (a box resting across two others): that overshoot made piles vibrate
-// and walk apart. The sum is scaled down to what moving the two bodies apart
-// without turning asks for, never up. The points' turns are averaged: each
-// was computed as if it alone turned the body.
-fn flush(acc: ptr<function, Snap>, m: ptr<function, PartnerSum>) -> u32 {
-    let touched = u32((*m).points > 0u);
-    let n_scale = min(1.0, 1.0 / max((*m).pair_w * (*m).normal_inv_w, 1e-30));
-    let f_scale = min(1.0, 1.0 / max((*m).pair_w * (*m).friction_inv_w, 1e-30));
-    (*acc).dx = (*acc).dx + (*m).normal_dx * n_scale + (*m).friction_dx * f_scale;
-    (*acc).dtheta = (*acc).dtheta + (*m).dtheta / f32(max((*m).points, 1u));
-    *m = PartnerSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
-    return touched;
+    let n = manifolds[k].normal; // from a to b: a is pushed along -n, b along n
+    let mu = combined_friction(ea, eb);
+    // summed over the points, for a: normal and friction pushes (b gets the
+    // opposite), their moments about each centre, the sums of 1 / w
+    var normal_j = vec3<f32>(0.0);
+    var friction_j = vec3<f32>(0.0);
+    var moment_a = vec3<f32>(0.0);
+    var moment_b = vec3<f32>(0.0);
+    var normal_inv_w = 0.0;
+    var friction_inv_w = 0.0;
+    var points = 0u;
+    var pressed = 0u;
+    for (var q = 0u; q < manifolds[k].count; q = q + 1u) {
+        let pt = manifolds[k].points[q];
+        let ra = quat_rotate(ea.rot, pt.local_a);
+        let rb = quat_rotate(eb.rot, pt.local_b);
+        let on_a = ea.pos + ra;
+        let on_b = eb.pos + rb;
+        let before_a = ea.prev_pos + quat_rotate(ea.prev_rot, pt.local_a);
+        let before_b = eb.prev_pos + quat_rotate(eb.prev_rot, pt.local_b);
+        // Overlap the bodies already had at their previous poses is pushed
+        // out at no more than MAX_DEPENETRATION_SPEED: a full snap in one
+        // substep would turn into that much velocity (Verlet), and deep
+        // overlaps (thin limbs passing through each other, bodies placed
+        // overlapping) launched bodies at tens of m/s. Overlap made by this
+        // substep's approach is removed whole.
+        let overlap_before = dot(before_a - before_b, n);
+        let depth = dot(on_a - on_b, n) - max(overlap_before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
+        // a contact that pushed earlier in this substep keeps its friction
+        // while it still touches, even once its depth is resolved, so
+        // sideways pushes from other contacts in later sweeps are resisted too
+        var push = 0.0;
+        var snapped = false;
+        if (depth > 0.0) {
+            let w = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
+            let j = n * (depth / w); // pushes b along n, a along -n
+            normal_j = normal_j + j;
+            moment_a = moment_a + cross(ra, j);
+            moment_b = moment_b + cross(rb, j);
+            normal_inv_w = normal_inv_w + 1.0 / w;
+            push = depth * params.relaxation;
+            snapped = true;
+        }
+        if (depth > 0.0 || (pt.pushed > 0.0 && depth >= -CONTACT_SLOP)) {
+            // how far a's point slid against b's since the previous poses
+            let slip = (on_a - before_a) - (on_b - before_b);
+            let slip_t = slip - n * dot(slip, n);
+            let slide = length(slip_t);
+            if (slide > 1e-9 && slide <= mu * (pt.pushed + push)) {
+                let t = slip_t / slide;
+                let w = end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t);
+                let j = t * (slide / w); // pulls b along t, a back along -t
+                friction_j = friction_j + j;
+                moment_a = moment_a + cross(ra, j);
+                moment_b = moment_b + cross(rb, j);
+                friction_inv_w = friction_inv_w + 1.0 / w;
+                snapped = true;
+            }
+        }
+        manifolds[k].points[q].pushed = pt.pushed + push;
+        if (pt.pushed + push > 0.0) {
+            pressed = 1u;
+        }
+        points = points + u32(snapped);
+    }
+    var pair_w = 0.0;
+    if (ea.moves) {
+        pair_w = pair_w + ea.inv_inertia.w;
+    }
+    if (eb.moves) {
+        pair_w = pair_w + eb.inv_inertia.w;
+    }
+    let n_scale = min(1.0, 1.0 / max(pair_w * normal_inv_w, 1e-30));
+    let f_scale = min(1.0, 1.0 / max(pair_w * friction_inv_w, 1e-30));
+    let j = normal_j * n_scale + friction_j * f_scale;
+    let turns = 1.0 / f32(max(points, 1u));
+    let touched = u32(points > 0u);
+    snaps[k] = ManifoldSnaps(end_snap(ea, -j, -moment_a * turns, touched, pressed),
+                             end_snap(eb, j, moment_b * turns, touched, pressed));
 }
 
 // One end of a ball joint: snap this body's share of the gap between the two
@@ -135,44 +170,15 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     var acc = Snap(vec3<f32>(0.0), vec3<f32>(0.0));
     var touching = 0u;
     // 1 if a contact pushed in this substep: integrate's test for sleeping
-    var pressed = 0.0;
-    var m = PartnerSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, 0.0, vec3<f32>(0.0), 0u);
-    // the body's pairs in pair order (pairs.wgsl), one manifold each
+    var pressed = 0u;
+    // the body's manifolds in pair order (contact_lists)
     let first = pair_meta[i].list_start;
-    let end = min(first + pair_meta[i].total, arrayLength(&body_pairs));
-    for (var e = first; e < end; e = e + 1u) {
-        let q = body_pairs[e];
-        if (q == NONE) {
-            continue;
-        }
-        let pr = pairs[q];
-        if (pr.manifold == NONE) {
-            continue;
-        }
-        let self_is_a = pr.a == i;
-        let normal = manifolds[pr.manifold].normal;
-        let points = manifolds[pr.manifold].count;
-        for (var k = 0u; k < points; k = k + 1u) {
-            let c = contact_view(pr, normal, manifolds[pr.manifold].points[k], self_is_a);
-            m.pair_w = p.inv_inertia.w;
-            if (partner_moves(c)) {
-                m.pair_w = m.pair_w + props[c.partner].inv_inertia.w;
-            }
-            let count_before = m.normal_inv_w + m.friction_inv_w;
-            let push = add_contact(&m, s, p, c);
-            if (self_is_a) {
-                manifolds[pr.manifold].points[k].pushed_a = c.pushed + push;
-            } else {
-                manifolds[pr.manifold].points[k].pushed_b = c.pushed + push;
-            }
-            if (c.pushed + push > 0.0) {
-                pressed = 1.0;
-            }
-            if (m.normal_inv_w + m.friction_inv_w != count_before) {
-                m.points = m.points + 1u;
-            }
-        }
-        touching = touching + flush(&acc, &m);
+    for (var e = first; e < first + pair_meta[i].contacts; e = e + 1u) {
+        let snap = snap_of(body_pairs[e]);
+        acc.dx = acc.dx + snap.dx;
+        acc.dtheta = acc.dtheta + snap.dtheta;
+        touching = touching + snap.count;
+        pressed = max(pressed, snap.pressed);
     }
     for (var k = joint_start[i]; k < joint_start[i + 1u]; k = k + 1u) {
         if (add_joint(&acc, s, p, joint_refs[k])) {
@@ -181,12 +187,12 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // Each snap turns the body as if it were the only one; summed they
     // overshoot (four corners correcting a twist turn it back about twice too
-    // far), so a partner's points share one turn (their mean, in `flush`) and
-    // the partners' turns are averaged too (mass splitting, for the inertia
-    // only: translations are scaled per partner in `flush`).
+    // far), so a partner's points share one turn (their mean, in
+    // solve_contacts) and the partners' turns are averaged too (mass
+    // splitting, for the inertia only: translations are scaled per partner).
     let split = 1.0 / f32(max(touching, 1u));
     s.pos = vec4<f32>(s.pos.xyz + acc.dx * params.relaxation, s.pos.w);
-    s.prev_pos.w = pressed;
+    s.prev_pos.w = f32(pressed);
     s.rot = quat_add_rotation(s.rot, acc.dtheta * (params.relaxation * split));
     state_out[i] = s;
 }

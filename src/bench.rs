@@ -30,7 +30,7 @@ use serde::Serialize;
 use crate::gpu::{types::*, Gpu};
 use crate::render::Renderer;
 use crate::scene::Scene;
-use crate::step::Stage;
+use crate::step::Part;
 use crate::world::{self, StageTimes, World};
 use crate::{scenes, Error};
 
@@ -164,9 +164,12 @@ pub struct Stages {
     pub steps: u64,
     /// The seven grid passes together.
     pub broadphase: f64,
+    /// The pair list (`pairs_*`), the narrowphase and its dispatch.
     pub narrowphase: f64,
     pub integrate: f64,
+    /// Both halves of every sweep (`solve_contacts`, `solve`).
     pub solve: f64,
+    /// Both halves (`restitution_contacts`, `restitution`).
     pub restitution: f64,
     /// Sum of the above.
     pub total: f64,
@@ -176,10 +179,9 @@ pub struct Stages {
 
 impl Stages {
     fn from_times(t: &StageTimes, steps: u64) -> Stages {
-        let get = |s: Stage| t.ms_per_step.iter().find(|(k, _)| *k == s).map_or(0.0, |x| x.1);
-        let broadphase = Stage::ALL.iter().filter(|s| s.is_broadphase()).map(|&s| get(s)).sum::<f64>();
-        let (narrowphase, integrate, solve, restitution) =
-            (get(Stage::Narrowphase), get(Stage::Integrate), get(Stage::Solve), get(Stage::Restitution));
+        let part = |p: Part| t.ms_per_step.iter().filter(|(s, _)| s.part() == p).map(|x| x.1).sum::<f64>();
+        let (broadphase, narrowphase, integrate, solve, restitution) =
+            (part(Part::Broadphase), part(Part::Narrowphase), part(Part::Integrate), part(Part::Solve), part(Part::Restitution));
         Stages {
             source: if t.gpu_timestamps { "GPU timestamps" } else { "wall clock per pass" }.into(),
             steps,
@@ -365,10 +367,11 @@ pub fn gpu_bytes(scene: &Scene) -> u64 {
         + size(4 * large.len() as u64)
         + size(pairs * std::mem::size_of::<Pair>() as u64)
         + size(manifolds * std::mem::size_of::<ContactManifold>() as u64)
+        + size(manifolds * std::mem::size_of::<ManifoldSnaps>() as u64)
         + size((n + 1) * std::mem::size_of::<PairMeta>() as u64)
         + size(2 * pairs * 4)
         + 64
-        + 16
+        + 32
         + PARAMS_STRIDE * 64
         + joints
 }

@@ -412,6 +412,12 @@ fn run(args: RunArgs) -> Result<(), Error> {
         println!("{frames_written} frames in {}", dir.display());
     }
     let report = world.contact_report()?;
+    if args.profile {
+        println!(
+            "contacts in the last step: {} candidate pairs, {} manifolds (most in a step: {}, {}; room for {}, {})",
+            report.pairs, report.manifolds, report.pairs_max, report.manifolds_max, report.pair_capacity, report.manifold_capacity
+        );
+    }
     if report.overflowed() {
         eprintln!(
             "warning: the contact pools overflowed: up to {} candidate pairs ({} fit) and {} manifolds ({} fit) \

@@ -42,17 +42,23 @@ struct WorldData {
     /// manifold pool, each body's pair bookkeeping and its pair list.
     pairs: wgpu::Buffer,
     manifolds: wgpu::Buffer,
+    /// What each manifold asks of its two bodies in a sweep (one per
+    /// manifold slot; solve.wgsl, restitution.wgsl).
+    snaps: wgpu::Buffer,
     pair_meta: wgpu::Buffer,
     body_pairs: wgpu::Buffer,
-    /// The narrowphase's indirect dispatch, copied from `status` before it.
+    /// The indirect dispatches: the narrowphase's at 0, copied from
+    /// `status` before it, the contact passes' at 16, copied after
+    /// `contact_lists`.
     dispatch: wgpu::Buffer,
     /// `bind_groups[k]` reads `states[k]` and writes `states[1 - k]`
     /// (always made, right after the buffers).
     bind_groups: Option<[wgpu::BindGroup; 2]>,
     /// Shapes, masses and materials (written by the input kernel too).
     props: wgpu::Buffer,
-    /// What the scene fixed at start-up: the bodies kept out of the grid and
-    /// the joint lists (the snapshot's scene hash reads them).
+    /// What the scene fixed at start-up: the bodies kept out of the grid
+    /// (copied into the tail of `sorted`, where the passes read them) and the
+    /// joint lists (the snapshot's scene hash reads them all).
     statics: [wgpu::Buffer; 3],
     /// Working buffers of the passes: vel0, and the grid's cell_count,
     /// cell_start, block_sums and sorted.
@@ -64,7 +70,7 @@ impl WorldData {
     /// with state_in and state_out per direction.
     fn step_bind_groups(&self, device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> [wgpu::BindGroup; 2] {
         let [vel0, cell_count, cell_start, block_sums, sorted] = &self.scratch;
-        let [large, joint_start, joint_refs] = &self.statics;
+        let [_, joint_start, joint_refs] = &self.statics;
         let group = |from: usize| {
             let buffers: [&wgpu::Buffer; STORAGE_BUFFERS as usize] = [
                 &self.props,
@@ -75,7 +81,7 @@ impl WorldData {
                 cell_start,
                 block_sums,
                 sorted,
-                large,
+                &self.snaps,
                 &self.pairs,
                 &self.manifolds,
                 &self.status,
@@ -254,12 +260,12 @@ pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
 
 /// Bytes of GPU memory per body: poses (two buffers), properties, velocities,
 /// the pair list (pairs, the bodies' lists of them, their bookkeeping), the
-/// manifold pool, and the grid's share (sorted list, about two hash buckets
+/// manifold pool with its snaps, and the grid's share (sorted list, about two hash buckets
 /// with their counts and starts).
 pub fn bytes_per_body() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
     let pairs = PAIRS_PER_BODY * (std::mem::size_of::<Pair>() as u64 + 2 * 4) + std::mem::size_of::<PairMeta>() as u64;
-    let manifolds = MANIFOLDS_PER_BODY * std::mem::size_of::<ContactManifold>() as u64;
+    let manifolds = MANIFOLDS_PER_BODY * (std::mem::size_of::<ContactManifold>() + std::mem::size_of::<ManifoldSnaps>()) as u64;
     let grid = 4 + 2 * 8;
     2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + pairs + manifolds + grid
 }
@@ -336,12 +342,13 @@ impl World {
         let (pair_capacity, manifold_capacity) = pair_capacities(&gpu, count as u64);
         let pairs = storage("pairs", pair_capacity * std::mem::size_of::<Pair>() as u64);
         let manifolds = storage("manifolds", manifold_capacity * std::mem::size_of::<ContactManifold>() as u64);
+        let snaps = storage("manifolds/snaps", manifold_capacity * std::mem::size_of::<ManifoldSnaps>() as u64);
         let pair_meta = storage("pairs/meta", (count as u64 + 1) * std::mem::size_of::<PairMeta>() as u64);
         let body_pairs = storage("pairs/body_lists", 2 * pair_capacity * 4);
         let status = with_data("status", bytemuck::cast_slice(&STATUS_INIT));
         let dispatch = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("narrowphase dispatch"),
-            size: 16,
+            label: Some("indirect dispatches"),
+            size: 32,
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -361,6 +368,7 @@ impl World {
             status,
             pairs,
             manifolds,
+            snaps,
             pair_meta,
             body_pairs,
             dispatch,
@@ -370,6 +378,14 @@ impl World {
             scratch: [vel0, cell_count, cell_start, block_sums, sorted],
         };
         data.bind_groups = Some(data.step_bind_groups(device, &pipelines.layout));
+        if !large.is_empty() {
+            // the grid's part of `sorted` holds the other bodies, n - large of them
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("large bodies") });
+            let [large_buf, ..] = &data.statics;
+            let sorted = &data.scratch[4];
+            encoder.copy_buffer_to_buffer(large_buf, 0, sorted, 4 * (n - large.len()) as u64, 4 * large.len() as u64);
+            gpu.queue.submit([encoder.finish()]);
+        }
         gpu.check()?;
         let substep_dt = settings.dt / settings.substeps as f32;
         Ok(World {
@@ -491,6 +507,7 @@ impl World {
         }
         if let Some(n) = manifolds {
             grow(&mut self.data.manifolds, "manifolds", n * std::mem::size_of::<ContactManifold>() as u64);
+            grow(&mut self.data.snaps, "manifolds/snaps", n * std::mem::size_of::<ManifoldSnaps>() as u64);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines.layout));
@@ -567,14 +584,17 @@ impl World {
 
     /// The passes of one step, each with the substep whose Params it uses:
     /// the broadphase and narrowphase once, then for every substep the
-    /// integration, `iterations` solves and restitution (the contacts, kept
-    /// in the bodies' own frames, serve all substeps).
+    /// integration, `iterations` sweeps of the solve's two halves and the
+    /// restitution's two (the contacts, kept in the bodies' own frames,
+    /// serve all substeps).
     pub fn step_plan(&self) -> Vec<(Stage, usize)> {
         let mut plan: Vec<(Stage, usize)> = Stage::ALL.iter().take_while(|s| **s != Stage::Integrate).map(|&s| (s, 0)).collect();
         for sub in 0..self.settings.substeps as usize {
             plan.push((Stage::Integrate, sub));
-            plan.extend(std::iter::repeat_n((Stage::Solve, sub), self.settings.iterations as usize));
-            plan.push((Stage::Restitution, sub));
+            for _ in 0..self.settings.iterations {
+                plan.extend([(Stage::SolveContacts, sub), (Stage::Solve, sub)]);
+            }
+            plan.extend([(Stage::RestitutionContacts, sub), (Stage::Restitution, sub)]);
         }
         plan
     }
@@ -589,7 +609,7 @@ impl World {
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
         let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
-        if stage.over() == Over::Pairs {
+        if stage == Stage::Narrowphase {
             // the pair scan wrote the dispatch's size into status[8..11]
             encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12);
         }
@@ -602,9 +622,14 @@ impl World {
         pass.set_bind_group(0, &groups[self.current], &offset);
         match stage.over() {
             Over::Pairs => pass.dispatch_workgroups_indirect(&self.data.dispatch, 0),
+            Over::Manifolds => pass.dispatch_workgroups_indirect(&self.data.dispatch, 16),
             over => pass.dispatch_workgroups(self.workgroups(over), 1, 1),
         }
         drop(pass);
+        if stage == Stage::ContactLists {
+            // the contact passes' dispatch, written into status[12..15]
+            encoder.copy_buffer_to_buffer(&self.data.status, 48, &self.data.dispatch, 16, 12);
+        }
         if stage.flips_state() {
             self.current = 1 - self.current;
         }
@@ -672,7 +697,7 @@ impl World {
             Over::ScanBlocks => self.grid.hash_size.div_ceil(SCAN_BLOCK),
             Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_BLOCK),
             Over::One => 1,
-            Over::Pairs => unreachable!("the narrowphase is dispatched indirectly"),
+            Over::Pairs | Over::Manifolds => unreachable!("dispatched indirectly"),
         };
         n.max(1)
     }
@@ -722,19 +747,18 @@ impl World {
         let read = |b: &wgpu::Buffer| self.gpu.read_buffer(b, b.size());
         let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&read(&self.data.pair_meta)?);
         let lists: Vec<u32> = bytemuck::pod_collect_to_vec(&read(&self.data.body_pairs)?);
-        let pairs: Vec<Pair> = bytemuck::pod_collect_to_vec(&read(&self.data.pairs)?);
         let manifolds: Vec<ContactManifold> = bytemuck::pod_collect_to_vec(&read(&self.data.manifolds)?);
         let mut out = vec![Vec::new(); n];
         for (i, list) in out.iter_mut().enumerate() {
+            // contact references (shaders/narrowphase.wgsl's contact_lists)
             let first = meta[i].list_start as usize;
-            let entries = lists.get(first..first + meta[i].total as usize).unwrap_or(&[]);
-            for &p in entries {
-                let Some(pair) = pairs.get(p as usize) else { continue };
-                let Some(m) = manifolds.get(pair.manifold as usize) else { continue };
-                let me_a = pair.a as usize == i;
+            let entries = lists.get(first..first + meta[i].contacts as usize).unwrap_or(&[]);
+            for &r in entries {
+                let Some(m) = manifolds.get(r as usize / 2) else { continue };
+                let me_a = r % 2 == 0;
                 for pt in &m.points[..m.count as usize] {
                     let (local_self, partner, local_partner, sign) =
-                        if me_a { (pt.local_a, pair.b, pt.local_b, -1.0) } else { (pt.local_b, pair.a, pt.local_a, 1.0) };
+                        if me_a { (pt.local_a, m.b, pt.local_b, -1.0) } else { (pt.local_b, m.a, pt.local_a, 1.0) };
                     list.push(BodyContact { local_self, partner, local_partner, normal: m.normal.map(|v| v * sign) });
                 }
             }

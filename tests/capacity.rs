@@ -28,15 +28,15 @@ fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
 
 #[test]
 fn the_pair_pools_grow_for_a_crowded_scene() {
-    // an 8 x 8 x 8 lattice of balls 0.9 diameters apart, no gravity: every
-    // ball's 26 lattice neighbours are candidates (about 10 owned pairs a
-    // body, more than the list holds at first) and its 6 nearest touch it
+    // an 8 x 8 x 8 lattice of balls 0.55 diameters apart, no gravity: every
+    // ball overlaps its 26 lattice neighbours, all of them candidates (about
+    // 10 owned pairs a body, more than the list holds at first)
     let side = 8usize;
     let mut scene = scenes::stack(0);
     scene.ground = None;
     scene.settings.gravity = [0.0; 3];
     for k in 0..side * side * side {
-        let at = Vec3::new((k % side) as f32, ((k / side) % side) as f32, (k / side / side) as f32) * 0.9;
+        let at = Vec3::new((k % side) as f32, ((k / side) % side) as f32, (k / side / side) as f32) * 0.55;
         scene.bodies.push(sphere_body(0.5, at.to_array()));
     }
     let n = scene.bodies.len();
@@ -46,22 +46,40 @@ fn the_pair_pools_grow_for_a_crowded_scene() {
     let first = w.contact_report().unwrap();
     w.step(1).unwrap();
     let second = w.contact_report().unwrap();
-    eprintln!("made {before:?}\nafter one step {first:?}\nafter two {second:?}");
+    w.step(1).unwrap();
+    let third = w.contact_report().unwrap();
+    eprintln!("made {before:?}\nafter one step {first:?}\nafter two {second:?}\nafter three {third:?}");
     // pairs of lattice neighbours (face, edge and corner diagonals)
     let m = side - 1;
     let lattice_pairs = (3 * m * side * side + 6 * m * m * side + 4 * m * m * m) as u32;
     assert!(before.pair_capacity < lattice_pairs, "the list held every pair from the start: {before:?}");
     assert_eq!(first.pairs, lattice_pairs, "the first step's candidate pairs");
     assert!(second.pair_capacity >= lattice_pairs, "the list did not grow: {second:?}");
-    assert!(!second.overflowed() || second.pairs_max > second.pair_capacity.min(first.pairs), "{second:?}");
-    assert_eq!(second.pairs, lattice_pairs, "the second step's candidate pairs");
-    // after growing, every ball holds a contact with each of its face neighbours
+    // the balls push apart (at most 3 m/s) and their reach grows with their
+    // speed, so later steps may want more pairs; each growth keeps up
+    assert!(third.pairs <= third.pair_capacity && third.manifolds <= third.manifold_capacity, "{third:?}");
+    // every ball still holds a contact with each of its face neighbours
+    // (0.55 apart at first, less than 0.1 m further after three steps)
     let contacts = w.read_contacts().unwrap();
     for (k, list) in contacts.iter().enumerate().take(n) {
         let (x, y, z) = (k % side, (k / side) % side, k / side / side);
-        let faces = [x > 0, x < m, y > 0, y < m, z > 0, z < m].iter().filter(|&&b| b).count();
-        let mut partners: Vec<u32> = list.iter().map(|c| c.partner).collect();
-        partners.dedup();
-        assert_eq!(partners.len(), faces, "ball {k} at {x} {y} {z} touches {partners:?}");
+        let index = |x: usize, y: usize, z: usize| (x + side * (y + side * z)) as u32;
+        let mut faces = Vec::new();
+        for (near, at) in [
+            (x > 0, (x.wrapping_sub(1), y, z)),
+            (x < m, (x + 1, y, z)),
+            (y > 0, (x, y.wrapping_sub(1), z)),
+            (y < m, (x, y + 1, z)),
+            (z > 0, (x, y, z.wrapping_sub(1))),
+            (z < m, (x, y, z + 1)),
+        ] {
+            if near {
+                faces.push(index(at.0, at.1, at.2));
+            }
+        }
+        let partners: Vec<u32> = list.iter().map(|c| c.partner).collect();
+        for f in &faces {
+            assert!(partners.contains(f), "ball {k} at {x} {y} {z} has no contact with its face neighbour {f}: {partners:?}");
+        }
     }
 }

@@ -45,9 +45,11 @@ fn shared_structs_match_member_by_member() {
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });
     check_layout!(common, Pair { a, b, manifold });
-    check_layout!(common, ContactPoint { local_a, pushed_a, local_b, pushed_b });
-    check_layout!(common, ContactManifold { normal, count, points });
-    check_layout!(common, PairMeta { owned, total, owned_start, list_start, cursor, woken, moves, _pad0, extent, reach });
+    check_layout!(common, ContactPoint { local_a, pushed, local_b, _pad0 });
+    check_layout!(common, ContactManifold { normal, count, a, b, _pad0, _pad1, points });
+    check_layout!(common, EndSnap { dx, count, dtheta, pressed });
+    check_layout!(common, ManifoldSnaps { a, b });
+    check_layout!(common, PairMeta { owned, total, owned_start, list_start, cursor, woken, moves, contacts, extent, reach });
 }
 
 #[test]

@@ -13,6 +13,7 @@ pub const RESTITUTION: &str = include_str!("../../shaders/restitution.wgsl");
 
 const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
 const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
+const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE];
 
 /// Every compute pass: its name (the label of its compute pass), its entry
 /// point (named like the pass, but for the scan passes, which grid.wgsl
@@ -32,9 +33,12 @@ pub const PASSES: &[(&str, &str, &[&str])] = &[
     ("pairs_scan_add", "scan_add", GRID_PASS),
     ("pairs_write", "pairs_write", PAIRS_PASS),
     ("pairs_sort", "pairs_sort", PAIRS_PASS),
-    ("narrowphase", "narrowphase", &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE]),
+    ("narrowphase", "narrowphase", NARROWPHASE_PASS),
+    ("contact_lists", "contact_lists", NARROWPHASE_PASS),
     ("integrate", "integrate", &[COMMON, BINDINGS, INTEGRATE]),
+    ("solve_contacts", "solve_contacts", &[COMMON, BINDINGS, SOLVE]),
     ("solve", "solve", &[COMMON, BINDINGS, SOLVE]),
+    ("restitution_contacts", "restitution_contacts", &[COMMON, BINDINGS, RESTITUTION]),
     ("restitution", "restitution", &[COMMON, BINDINGS, RESTITUTION]),
 ];
 

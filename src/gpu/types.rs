@@ -95,21 +95,45 @@ pub struct Pair {
 pub struct ContactPoint {
     /// On body a, in its frame.
     pub local_a: [f32; 3],
-    /// Body a's normal push summed over the substep's sweeps (m).
-    pub pushed_a: f32,
+    /// The normal push summed over the substep's sweeps (m): the point's
+    /// friction budget.
+    pub pushed: f32,
     /// On body b, in its frame (the ground's: world coordinates).
     pub local_b: [f32; 3],
-    pub pushed_b: f32,
+    pub _pad0: f32,
 }
 
-/// A pair's manifold (144 bytes): up to `MAX_POINTS` points sharing one
-/// world normal, pointing from a to b.
+/// A pair's manifold (160 bytes): up to `MAX_POINTS` points sharing one
+/// world normal, pointing from a to b (a body, or `GROUND`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ContactManifold {
     pub normal: [f32; 3],
     pub count: u32,
+    pub a: u32,
+    pub b: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
     pub points: [ContactPoint; 4],
+}
+
+/// What a manifold asks of one of its bodies in a sweep (32 bytes); see
+/// `EndSnap` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EndSnap {
+    pub dx: [f32; 3],
+    pub count: u32,
+    pub dtheta: [f32; 3],
+    pub pressed: u32,
+}
+
+/// Both ends' snaps of one manifold (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ManifoldSnaps {
+    pub a: EndSnap,
+    pub b: EndSnap,
 }
 
 /// A body's pair bookkeeping (48 bytes); see `PairMeta` in common.wgsl.
@@ -124,7 +148,9 @@ pub struct PairMeta {
     pub woken: u32,
     /// 1 if contacts can move the body this step.
     pub moves: u32,
-    pub _pad0: u32,
+    /// How many of its list's entries, after the narrowphase, are contact
+    /// references (`2 * manifold + 1 if the body is the pair's b`).
+    pub contacts: u32,
     /// Half extents of its world box grown by its reach (m).
     pub extent: [f32; 3],
     /// How far it may move this step (m).

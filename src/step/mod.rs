@@ -2,13 +2,18 @@
 //!
 //! 1. `grid_*`       — broadphase: counting sort of bodies into a hashed grid (shaders/grid.wgsl)
 //! 2. `pairs_*`      — every candidate pair once, and each body's list of its pairs (shaders/pairs.wgsl)
-//! 3. `narrowphase`  — one invocation per pair: its manifold, into the pool (shaders/narrowphase.wgsl, collide.wgsl)
+//! 3. `narrowphase`  — one invocation per pair: its manifold, into the pool (shaders/narrowphase.wgsl, collide.wgsl);
+//!    `contact_lists` keeps in each body's list only its pairs with a manifold
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
-//! 5. `solve`        — `iterations` Jacobi sweeps of corrective snaps (shaders/solve.wgsl)
-//! 6. `restitution`  — bounce, by rewriting the previous pose (shaders/restitution.wgsl)
+//! 5. `solve_contacts`, `solve` — `iterations` Jacobi sweeps of corrective snaps:
+//!    per manifold what it asks of its bodies, then per body the sum (shaders/solve.wgsl)
+//! 6. `restitution_contacts`, `restitution` — bounce and dynamic friction, by
+//!    rewriting the previous pose, in the same two halves (shaders/restitution.wgsl)
 //!
-//! Passes 1-3 only read the state; 4-6 read one state buffer and write the
-//! other, so the current state flips after each of them. This type holds
+//! Passes 1-3 only read the state; `integrate`, `solve` and `restitution`
+//! read one state buffer and write the other, so the current state flips
+//! after each of them; the `*_contacts` passes write only the manifolds'
+//! snaps and friction budgets. This type holds
 //! only compiled pipelines and their layout; the buffers live in `World`.
 
 use crate::gpu::{shaders, types::*, Gpu};
@@ -31,8 +36,11 @@ pub enum Stage {
     PairsWrite,
     PairsSort,
     Narrowphase,
+    ContactLists,
     Integrate,
+    SolveContacts,
     Solve,
+    RestitutionContacts,
     Restitution,
 }
 
@@ -50,10 +58,13 @@ pub enum Over {
     /// The candidate pairs: an indirect dispatch whose size the pair scan
     /// wrote (status[8..11], copied to the world's `dispatch` buffer).
     Pairs,
+    /// The manifolds in the pool: an indirect dispatch whose size
+    /// `contact_lists` wrote (status[12..15], copied to `dispatch` + 16).
+    Manifolds,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 17] = [
+    pub const ALL: [Stage; 20] = [
         Stage::GridClear,
         Stage::GridCount,
         Stage::GridScanBlocks,
@@ -68,8 +79,11 @@ impl Stage {
         Stage::PairsWrite,
         Stage::PairsSort,
         Stage::Narrowphase,
+        Stage::ContactLists,
         Stage::Integrate,
+        Stage::SolveContacts,
         Stage::Solve,
+        Stage::RestitutionContacts,
         Stage::Restitution,
     ];
 
@@ -91,8 +105,11 @@ impl Stage {
             Stage::PairsWrite => "pairs_write",
             Stage::PairsSort => "pairs_sort",
             Stage::Narrowphase => "narrowphase",
+            Stage::ContactLists => "contact_lists",
             Stage::Integrate => "integrate",
+            Stage::SolveContacts => "solve_contacts",
             Stage::Solve => "solve",
+            Stage::RestitutionContacts => "restitution_contacts",
             Stage::Restitution => "restitution",
         }
     }
@@ -100,6 +117,20 @@ impl Stage {
     /// Whether the stage is part of the grid broadphase (`grid_*`).
     pub fn is_broadphase(self) -> bool {
         self.name().starts_with("grid_")
+    }
+
+    /// The part of the step the stage belongs to, as the bench and the
+    /// profile sum them: broadphase (`grid_*`), narrowphase (`pairs_*`, the
+    /// narrowphase and its dispatch), integrate, solve (both halves),
+    /// restitution (both halves).
+    pub fn part(self) -> Part {
+        match self {
+            s if s.is_broadphase() => Part::Broadphase,
+            Stage::Integrate => Part::Integrate,
+            Stage::SolveContacts | Stage::Solve => Part::Solve,
+            Stage::RestitutionContacts | Stage::Restitution => Part::Restitution,
+            _ => Part::Narrowphase,
+        }
     }
 
     /// Whether the stage is one of grid.wgsl's scan passes run over the
@@ -120,9 +151,20 @@ impl Stage {
             Stage::GridScanSums | Stage::PairsScanSums => Over::One,
             Stage::PairsScanBlocks => Over::BodyScanBlocks,
             Stage::Narrowphase => Over::Pairs,
+            Stage::SolveContacts | Stage::RestitutionContacts => Over::Manifolds,
             _ => Over::Bodies,
         }
     }
+}
+
+/// The parts of a step (see `Stage::part`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    Broadphase,
+    Narrowphase,
+    Integrate,
+    Solve,
+    Restitution,
 }
 
 /// Storage buffers the step's bind group holds (bindings 1-16 of
@@ -161,7 +203,7 @@ impl StepPipelines {
             },
             count: None,
         }];
-        let read_only = [1, 2, 9, 13, 14]; // props, state_in, large, joint_start, joint_refs
+        let read_only = [1, 2, 13, 14]; // props, state_in, joint_start, joint_refs
         for binding in 1..=STORAGE_BUFFERS {
             entries.push(storage(binding, read_only.contains(&binding)));
         }
