@@ -31,7 +31,7 @@ fn main() -> std::process::ExitCode {
         }])?;
         track.check(scene.bodies.len())?; // body indices against the scene, before anything runs
         let path = out.join("push.json");
-        std::fs::write(&path, track.to_json()).map_err(|source| verlet::Error::Io { path: path.display().to_string(), source })?;
+        common::write(&path, track.to_json())?;
 
         let mut world = World::new(&scene)?;
         let dt = world.settings().dt;

@@ -7,9 +7,10 @@
 //!
 //! The `sphere` scene drops a ball of radius 0.5 m (restitution 0.8) from
 //! 5 m. Every step is read back (`World::read_state`, one blocking copy of
-//! every body's state to the host) and written to `OUT_DIR/ball.csv`; the
-//! tops of the bounces are printed. Reading back every step is for tracing:
-//! `World::step(n)` with one readback at the end is far faster.
+//! every body's state to the host) and written to `OUT_DIR/ball.csv` (t in
+//! s, y in m, vy in m/s, asleep); the tops of the bounces are printed.
+//! Reading back every step is for tracing: `World::step(n)` with one
+//! readback at the end is far faster.
 
 mod common;
 
@@ -39,14 +40,15 @@ fn main() -> std::process::ExitCode {
             rising = vy > 0.0;
         }
         let path = out.join("ball.csv");
-        std::fs::write(&path, csv).map_err(|source| verlet::Error::Io { path: path.display().to_string(), source })?;
+        common::write(&path, csv)?;
         println!("{STEPS} steps traced to {}", path.display());
         // the ball starts with its bottom 4.5 m up; each bounce keeps about
         // restitution^2 of the height
         let mut height = 4.5;
         for (t, y) in apexes {
             let bottom = y - 0.5;
-            println!("top of a bounce at t = {t:.2} s: {bottom:.2} m up ({:.0}% of the one before)", 100.0 * bottom / height);
+            let kept = 100.0 * bottom / height;
+            println!("top of a bounce at t = {t:.2} s: {bottom:.2} m up ({kept:.0}% of the one before)");
             height = bottom;
         }
         Ok(())

@@ -462,10 +462,13 @@ fn track_events_after_the_last_step_are_warned_of() {
 // 5. A quiet doorstep (issue 15)
 // ---------------------------------------------------------------------------
 
+/// Variables set, and variables removed, for a child.
+type Env = (&'static [(&'static str, &'static str)], &'static [&'static str]);
+
 /// Environments in which libwayland, asked by Mesa's device-select layer
 /// for the display's GPU, would print `error: XDG_RUNTIME_DIR is invalid or
-/// not set in the environment.`: (set, removed).
-const NO_RUNTIME_DIR: &[(&[(&str, &str)], &[&str])] = &[
+/// not set in the environment.`.
+const NO_RUNTIME_DIR: &[Env] = &[
     (&[], &["XDG_RUNTIME_DIR", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]),
     (&[("WAYLAND_DISPLAY", "wayland-0")], &["XDG_RUNTIME_DIR", "WAYLAND_SOCKET"]),
     (&[("XDG_RUNTIME_DIR", "not/absolute")], &["WAYLAND_DISPLAY", "WAYLAND_SOCKET"]),
@@ -493,7 +496,8 @@ fn without_a_runtime_dir_real_errors_still_show() {
     // fails after the adapters were enumerated (the probe ran): the error
     // must be there, and alone
     for (set, unset) in NO_RUNTIME_DIR {
-        let env: Vec<(&str, &str)> = set.iter().copied().chain([("WGPU_ADAPTER_NAME", "no-such-adapter-anywhere")]).collect();
+        let wanted = ("WGPU_ADAPTER_NAME", "no-such-adapter-anywhere");
+        let env: Vec<(&str, &str)> = set.iter().copied().chain([wanted]).collect();
         let (out, _) = capped_env_without(&["info"], &env, unset);
         assert_refused(&["info"], &out, &["WGPU_ADAPTER_NAME", "no-such-adapter-anywhere", "matches no adapter"]);
         assert!(!stderr(&out).contains("XDG_RUNTIME_DIR"), "{}", stderr(&out));

@@ -1,6 +1,8 @@
 //! What the examples share: where they write, and how they end.
+// each example uses only part of this
+#![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// The output directory: the first argument, else a fresh one under the
@@ -16,8 +18,17 @@ pub fn out_dir(example: &str) -> Result<PathBuf, verlet::Error> {
         Some(arg) => PathBuf::from(arg),
         None => std::env::temp_dir().join(format!("verlet-{example}-{}", std::process::id())),
     };
-    std::fs::create_dir_all(&dir).map_err(|source| verlet::Error::Io { path: dir.display().to_string(), source })?;
+    std::fs::create_dir_all(&dir).map_err(|source| io_error(&dir, source))?;
     Ok(dir)
+}
+
+/// Writes `contents` to `path`, naming the path in an error.
+pub fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<(), verlet::Error> {
+    std::fs::write(path, contents).map_err(|source| io_error(path, source))
+}
+
+fn io_error(path: &Path, source: std::io::Error) -> verlet::Error {
+    verlet::Error::Io { path: path.display().to_string(), source }
 }
 
 /// Runs `example` after quieting the window-system probe (before any
