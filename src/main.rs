@@ -26,12 +26,12 @@ enum Command {
     Run(RunArgs),
     /// Print a built-in scene as JSON.
     Scene {
-        /// One of: drop, sphere, cubes, stack, pyramid, chain, bridge, ragdoll.
+        /// A built-in scene (listed below).
         name: String,
         /// Bodies, boxes, rows, links, planks or ragdolls, by scene.
         #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
         count: Option<usize>,
-        /// Seed of the random scenes (cubes).
+        /// Seed of the random scenes (cubes, pile).
         #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = whole_u64)]
         seed: u64,
     },
@@ -90,7 +90,7 @@ struct BenchArgs {
 struct RunArgs {
     /// The scene file (JSON, INTERFACE.md section 1). Without it, --builtin.
     scene: Option<PathBuf>,
-    /// A built-in scene to run instead of a file (see `verlet scene`).
+    /// A built-in scene to run instead of a file (listed below).
     #[arg(long, conflicts_with = "scene")]
     builtin: Option<String>,
     /// --count of the built-in scene.
@@ -145,8 +145,34 @@ struct RunArgs {
     height: u32,
 }
 
+/// The command line as `Cli::try_parse` reads it, with the built-in scenes
+/// listed under the help of `verlet`, `verlet scene` and `verlet run`.
+fn parse() -> Result<Cli, clap::Error> {
+    use clap::{CommandFactory, FromArgMatches};
+    let list = scene_list();
+    let mut command = Cli::command()
+        .after_help(list.clone())
+        .mut_subcommand("scene", |c| c.after_help(list.clone()))
+        .mut_subcommand("run", |c| c.after_help(list.clone()));
+    let mut matches = command.try_get_matches_from_mut(std::env::args_os())?;
+    Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))
+}
+
+/// The built-in scenes, a line each, from `scenes::NAMES` (so a scene added
+/// there is listed without touching the help).
+fn scene_list() -> String {
+    let width = scenes::NAMES.iter().map(|(name, _)| name.len()).max().unwrap_or(0);
+    let mut list = String::from("Built-in scenes (`verlet scene NAME`, `verlet run --builtin NAME`):");
+    for (name, what) in scenes::NAMES {
+        list.push_str(&format!("\n  {name:<width$}  {what}"));
+    }
+    list
+}
+
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    // before any thread starts: it may set an environment variable
+    verlet::gpu::quiet_window_system_probe();
+    let cli = match parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {
             let _ = e.print();

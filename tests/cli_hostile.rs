@@ -21,15 +21,23 @@ const QUICK: Duration = Duration::from_secs(5);
 /// Runs `verlet args` under `ulimit -v` (4 GB), with `env` set; returns the
 /// output and how long it took.
 fn capped_env(args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
+    capped_env_without(args, env, &[])
+}
+
+/// As `capped_env`, with the variables named in `unset` removed.
+fn capped_env_without(args: &[&str], env: &[(&str, &str)], unset: &[&str]) -> (Output, Duration) {
     let started = Instant::now();
-    let out = Command::new("sh")
+    let mut command = Command::new("sh");
+    command
         .arg("-c")
         .arg("ulimit -v 4000000 && exec \"$0\" \"$@\"")
         .arg(env!("CARGO_BIN_EXE_verlet"))
         .args(args)
-        .envs(env.iter().copied())
-        .output()
-        .expect("sh runs verlet");
+        .envs(env.iter().copied());
+    for var in unset {
+        command.env_remove(var);
+    }
+    let out = command.output().expect("sh runs verlet");
     (out, started.elapsed())
 }
 
@@ -448,4 +456,65 @@ fn track_events_after_the_last_step_are_warned_of() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("warning: --input: 1 of 2 events"), "{}", stderr(&out));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---------------------------------------------------------------------------
+// 5. A quiet doorstep (issue 15)
+// ---------------------------------------------------------------------------
+
+/// Variables set, and variables removed, for a child.
+type Env = (&'static [(&'static str, &'static str)], &'static [&'static str]);
+
+/// Environments in which libwayland, asked by Mesa's device-select layer
+/// for the display's GPU, would print `error: XDG_RUNTIME_DIR is invalid or
+/// not set in the environment.`.
+const NO_RUNTIME_DIR: &[Env] = &[
+    (&[], &["XDG_RUNTIME_DIR", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]),
+    (&[("WAYLAND_DISPLAY", "wayland-0")], &["XDG_RUNTIME_DIR", "WAYLAND_SOCKET"]),
+    (&[("XDG_RUNTIME_DIR", "not/absolute")], &["WAYLAND_DISPLAY", "WAYLAND_SOCKET"]),
+];
+
+#[test]
+fn a_headless_run_prints_only_its_own_lines() {
+    for (set, unset) in NO_RUNTIME_DIR {
+        for args in [&["info"][..], &["run", "--builtin", "drop", "--steps", "2"]] {
+            let (out, _) = capped_env_without(args, set, unset);
+            if no_adapter(&out) {
+                return;
+            }
+            let err = stderr(&out);
+            assert!(out.status.success(), "{args:?} with {set:?}, without {unset:?}: {err}");
+            assert!(!err.contains("XDG_RUNTIME_DIR"), "{args:?} with {set:?}, without {unset:?}: {err}");
+            assert!(!err.lines().any(|l| l.starts_with("error")), "{args:?} with {set:?}, without {unset:?}: {err}");
+            assert!(!String::from_utf8_lossy(&out.stdout).is_empty(), "{args:?}: printed nothing");
+        }
+    }
+}
+
+#[test]
+fn without_a_runtime_dir_real_errors_still_show() {
+    // fails after the adapters were enumerated (the probe ran): the error
+    // must be there, and alone
+    for (set, unset) in NO_RUNTIME_DIR {
+        let wanted = ("WGPU_ADAPTER_NAME", "no-such-adapter-anywhere");
+        let env: Vec<(&str, &str)> = set.iter().copied().chain([wanted]).collect();
+        let (out, _) = capped_env_without(&["info"], &env, unset);
+        assert_refused(&["info"], &out, &["WGPU_ADAPTER_NAME", "no-such-adapter-anywhere", "matches no adapter"]);
+        assert!(!stderr(&out).contains("XDG_RUNTIME_DIR"), "{}", stderr(&out));
+    }
+}
+
+#[test]
+fn help_lists_every_built_in_scene() {
+    for args in [&["--help"][..], &["scene", "--help"], &["run", "--help"], &["help", "scene"]] {
+        let (out, took) = capped(args);
+        let help = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+        for (name, what) in scenes::NAMES {
+            let line = help.lines().find(|l| l.split_whitespace().next() == Some(name));
+            let line = line.unwrap_or_else(|| panic!("{args:?}: no line for the {name} scene in {help}"));
+            assert!(line.contains(what), "{args:?}: {line:?} lacks {what:?}");
+        }
+        assert!(took < QUICK, "{args:?}: took {took:?}");
+    }
 }

@@ -214,6 +214,49 @@ impl Gpu {
     }
 }
 
+/// Keeps a headless run from printing libwayland's `error: XDG_RUNTIME_DIR
+/// is invalid or not set in the environment.` (twice) when it opens the
+/// GPU. Call it first thing in `main`, before any thread starts: it may set
+/// an environment variable, which is only sound while one thread runs
+/// (`verlet`'s `main` and the examples do; [`Gpu::new`] does not, since a
+/// library cannot know it is alone).
+///
+/// Why: wgpu-hal 30 enables every window-system surface extension the
+/// Vulkan loader offers (`VK_KHR_wayland_surface` among them,
+/// `Instance::desired_extensions`), and offers no option to leave them out
+/// (its instance callback may only add extensions). Mesa's implicit
+/// `VK_LAYER_MESA_device_select` layer sees that extension and, in each
+/// `vkEnumeratePhysicalDevices` (wgpu calls it twice: count, then fill),
+/// asks the Wayland compositor which GPU drives the display:
+/// `wl_display_connect(NULL)`. With `XDG_RUNTIME_DIR` unset or not an
+/// absolute path, and `WAYLAND_DISPLAY` not an absolute path, libwayland
+/// prints that line and fails. Exactly then no compositor can be reached
+/// anyway, so pointing `WAYLAND_DISPLAY` at `/dev/null`, an absolute path
+/// that holds no socket, changes no outcome: libwayland skips the runtime
+/// directory, its `connect` fails silently (ECONNREFUSED), and the layer
+/// falls back as before (the X server, then the boot VGA device).
+///
+/// What it costs: nothing is hidden but that line (stderr stays as it
+/// is), the variable is set only in that case, and this process's children
+/// inherit `WAYLAND_DISPLAY=/dev/null` (verlet starts none). A libwayland
+/// too old to take an absolute `WAYLAND_DISPLAY` still prints the line
+/// (Debian 12's 1.21 takes it). Other ways and why not: `NODEVICE_SELECT=1` turns the
+/// whole layer off (and with it `MESA_VK_DEVICE_SELECT` and `DRI_PRIME`);
+/// a made-up `XDG_RUNTIME_DIR` would have to be created, kept private and
+/// removed, and other libraries put files there.
+pub fn quiet_window_system_probe() {
+    if cfg!(all(unix, not(target_os = "macos"), not(target_os = "android"))) {
+        let absolute = |var: &str| std::env::var_os(var).is_some_and(|v| v.as_encoded_bytes().first() == Some(&b'/'));
+        // WAYLAND_SOCKET, an inherited connection, is used without a probe
+        let probe_complains = std::env::var_os("WAYLAND_SOCKET").is_none()
+            && !absolute("XDG_RUNTIME_DIR")
+            && !absolute("WAYLAND_DISPLAY");
+        if probe_complains {
+            std::env::set_var("WAYLAND_DISPLAY", "/dev/null");
+        }
+    }
+}
+
 /// The names `WGPU_BACKEND` takes (wgpu_types::Backends::from_comma_list).
 const BACKEND_NAMES: &[&str] = &["vulkan", "vk", "dx12", "d3d12", "metal", "mtl", "opengl", "gles", "gl", "webgpu", "noop"];
 /// The values `WGPU_POWER_PREF` takes (wgpu_types::PowerPreference::from_env).
