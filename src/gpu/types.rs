@@ -112,8 +112,9 @@ pub struct ContactManifold {
     pub count: u32,
     pub a: u32,
     pub b: u32,
+    /// `NONE`, or the face the narrowphase left to clip (within a step).
+    pub clip_face: u32,
     pub _pad0: u32,
-    pub _pad1: u32,
     pub points: [ContactPoint; 4],
 }
 

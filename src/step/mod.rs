@@ -3,7 +3,8 @@
 //! 1. `grid_*`       — broadphase: counting sort of bodies into a hashed grid (shaders/grid.wgsl)
 //! 2. `pairs_*`      — every candidate pair once, and each body's list of its pairs (shaders/pairs.wgsl)
 //! 3. `narrowphase`  — one invocation per pair: its manifold, into the pool (shaders/narrowphase.wgsl, collide.wgsl);
-//!    `contact_lists` keeps in each body's list only its pairs with a manifold
+//!    (boxes: the separating axis); `contact_lists` keeps in each body's list only its
+//!    pairs with a manifold; `narrowphase_clip` clips the face contacts, over the pool
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
 //! 5. `solve_contacts`, `solve` — `iterations` Jacobi sweeps of corrective snaps:
 //!    per manifold what it asks of its bodies, then per body the sum (shaders/solve.wgsl)
@@ -37,6 +38,7 @@ pub enum Stage {
     PairsSort,
     Narrowphase,
     ContactLists,
+    NarrowphaseClip,
     Integrate,
     SolveContacts,
     Solve,
@@ -64,7 +66,7 @@ pub enum Over {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 20] = [
+    pub const ALL: [Stage; 21] = [
         Stage::GridClear,
         Stage::GridCount,
         Stage::GridScanBlocks,
@@ -80,6 +82,7 @@ impl Stage {
         Stage::PairsSort,
         Stage::Narrowphase,
         Stage::ContactLists,
+        Stage::NarrowphaseClip,
         Stage::Integrate,
         Stage::SolveContacts,
         Stage::Solve,
@@ -106,6 +109,7 @@ impl Stage {
             Stage::PairsSort => "pairs_sort",
             Stage::Narrowphase => "narrowphase",
             Stage::ContactLists => "contact_lists",
+            Stage::NarrowphaseClip => "narrowphase_clip",
             Stage::Integrate => "integrate",
             Stage::SolveContacts => "solve_contacts",
             Stage::Solve => "solve",
@@ -151,7 +155,7 @@ impl Stage {
             Stage::GridScanSums | Stage::PairsScanSums => Over::One,
             Stage::PairsScanBlocks => Over::BodyScanBlocks,
             Stage::Narrowphase => Over::Pairs,
-            Stage::SolveContacts | Stage::RestitutionContacts => Over::Manifolds,
+            Stage::NarrowphaseClip | Stage::SolveContacts | Stage::RestitutionContacts => Over::Manifolds,
             _ => Over::Bodies,
         }
     }
