@@ -533,7 +533,7 @@ fn step_and_record(
             chunk = (chunk / 2).max(1);
         }
         let done = world.step_count();
-        if done % args.every == 0 || done == args.steps {
+        if done.is_multiple_of(args.every) || done == args.steps {
             recorder.record(world)?;
         }
         bar.set_position(done);
@@ -707,7 +707,7 @@ impl Reel {
         } else {
             image.clone()
         };
-        if self.seen % self.stride == 0 {
+        if self.seen.is_multiple_of(self.stride) {
             self.kept.push(small);
             self.latest = None;
             if self.kept.len() > self.cap {

@@ -967,7 +967,7 @@ fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
 }
 
 fn binding_limit(gpu: &Gpu) -> u64 {
-    (gpu.limits.max_storage_buffer_binding_size as u64).min(gpu.limits.max_buffer_size)
+    gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size)
 }
 
 /// The most bodies this GPU can hold: the poses must fit one storage

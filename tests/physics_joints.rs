@@ -158,8 +158,7 @@ fn a_chain_hung_by_both_ends_settles_into_a_catenary() {
     let centre_x = 0.5 * (left.x + right.x) as f64;
     let mut worst = 0.0f64;
     let mut worst_gap = 0.0f32;
-    for k in 0..links {
-        let s = &state[k];
+    for s in &state[..links] {
         let end = v3(s.position) + quat(s.orientation) * Vec3::new(0.5, 0.0, 0.0);
         let want = left.y as f64 + curve(end.x as f64 - centre_x);
         worst = worst.max((end.y as f64 - want).abs());

@@ -24,6 +24,7 @@
 //!   to the last; GPU memory 7 662 568 bytes in 18 allocations throughout;
 //!   no fault, nothing non-finite; at most 38 contact points wanted (24
 //!   kept); the fastest body still at 1.2 to 8.1 m/s after the pile landed.
+//!
 //! Earlier, partial runs:
 //! - before sleeping: 1000 steps in 1324 s; RSS 119.1 MB after the first
 //!   chunk, 119.3 MB at the end; GPU memory 7 662 568 bytes in 18
@@ -132,7 +133,17 @@ fn rss_kb() -> i64 {
 
 /// GPU memory as the allocator sees it: (bytes allocated, allocations), or
 /// None where the backend gives no report.
-fn gpu_memory(device: &wgpu::Device) -> Option<(u64, usize)> {
+/// Bytes and count of the GPU allocations, where the backend reports them.
+type GpuMemory = Option<(u64, usize)>;
+
+/// What the first chunk leaves: RSS (kB), GPU memory, live wgpu buffers.
+struct Baseline {
+    rss: i64,
+    gpu: GpuMemory,
+    buffers: isize,
+}
+
+fn gpu_memory(device: &wgpu::Device) -> GpuMemory {
     device.generate_allocator_report().map(|r| (r.total_allocated_bytes, r.allocations.len()))
 }
 
@@ -178,7 +189,7 @@ fn ten_thousand_steps_of_a_5000_body_pile_with_chains() {
         if counted == 0 { " (zero: wgpu's `counters` feature is off)" } else { "" }
     );
 
-    let mut baseline: Option<(i64, Option<(u64, usize)>, isize)> = None;
+    let mut baseline: Option<Baseline> = None;
     let mut rss_max = 0i64;
     let started = Instant::now();
     while world.step_count() < steps {
@@ -207,8 +218,8 @@ fn ten_thousand_steps_of_a_5000_body_pile_with_chains() {
         assert!(lowest > -1.0, "a body fell through the ground: y = {lowest}");
         match baseline {
             // the first chunk warms up (pipelines, staging, allocator pools)
-            None => baseline = Some((rss, gpu_now, counted_now)),
-            Some((rss0, gpu0, counted0)) => {
+            None => baseline = Some(Baseline { rss, gpu: gpu_now, buffers: counted_now }),
+            Some(Baseline { rss: rss0, gpu: gpu0, buffers: counted0 }) => {
                 assert_eq!(gpu_now, gpu0, "GPU memory changed after step {}", world.step_count());
                 assert_eq!(counted_now, counted0, "live wgpu buffers changed after step {}", world.step_count());
                 assert!(
@@ -222,7 +233,7 @@ fn ten_thousand_steps_of_a_5000_body_pile_with_chains() {
         }
     }
     let wall = started.elapsed().as_secs_f64();
-    let (rss0, gpu0, _) = baseline.unwrap();
+    let Baseline { rss: rss0, gpu: gpu0, .. } = baseline.unwrap();
     println!(
         "done: {} steps in {wall:.1} s ({:.1} ms/step); RSS at start {rss_start} kB, after warm-up {rss0} kB, \
          max {rss_max} kB, end {} kB; GPU memory after warm-up {gpu0:?}, end {:?}; contacts {:?}",

@@ -371,9 +371,9 @@ fn many_inputs_grow_the_op_list() {
     w.apply_inputs(&inputs).unwrap();
     w.step(1).unwrap();
     let s = w.read_state().unwrap();
-    for k in 0..300 {
+    for (k, b) in s.iter().enumerate().take(300) {
         let want = (299 - k) as f32 * 0.01;
-        assert!((s[k].linear_velocity[1] - want).abs() < 1e-3, "body {k}: {:?}", s[k].linear_velocity);
+        assert!((b.linear_velocity[1] - want).abs() < 1e-3, "body {k}: {:?}", b.linear_velocity);
         assert!(s[k].linear_velocity[0].abs() < 1e-4, "body {k}: {:?}", s[k].linear_velocity);
     }
 }
@@ -479,18 +479,18 @@ fn a_kinematic_paddle_moved_by_set_pose_pushes_boxes_without_passing_through() {
         w.step(1).unwrap();
         let s = w.read_state().unwrap();
         let face = x + 0.1;
-        for k in 1..4 {
+        for (k, b) in s.iter().enumerate().take(4).skip(1) {
             // how far a box's back face is behind the paddle's front face
-            let back = s[k].position[0] as f64 - 0.25;
+            let back = b.position[0] as f64 - 0.25;
             deepest = deepest.max(face - back);
-            assert!(s[k].position[0] as f64 > x, "step {n}: box {k} at {:?} passed the paddle at {x}", s[k].position);
+            assert!(b.position[0] as f64 > x, "step {n}: box {k} at {:?} passed the paddle at {x}", b.position);
         }
     }
     let s = w.read_state().unwrap();
     let x = -1.0 + speed * dt * 90.0;
     eprintln!("paddle at 2 m/s: deepest overlap {:.1} mm; boxes end at x = {:.3} {:.3} {:.3}, paddle front at {:.3}", deepest * 1e3, s[1].position[0], s[2].position[0], s[3].position[0], x + 0.1);
     assert!(deepest < 0.03, "the paddle sank {deepest} m into a box");
-    for k in 1..4 {
-        assert!(s[k].position[0] as f64 >= x + 0.1 + 0.25 - 0.03, "box {k} left behind at {:?}", s[k].position);
+    for (k, b) in s.iter().enumerate().take(4).skip(1) {
+        assert!(b.position[0] as f64 >= x + 0.1 + 0.25 - 0.03, "box {k} left behind at {:?}", b.position);
     }
 }

@@ -1,10 +1,12 @@
-//! Narrowphase reference (twin of `shaders/narrowphase.wgsl`): contact
+//! Narrowphase reference (twin of `shaders/collide.wgsl`): contact
 //! manifolds between boxes and spheres.
 //!
 //! A manifold has one normal `n`, pointing from the first shape to the
 //! second, and up to `MAX_POINTS` pairs of points (`on_a`, `on_b`) in world
 //! space. Its separation `dot(on_b - on_a, n)` is negative where the shapes
 //! overlap; pairs up to `margin` apart are kept too (speculative contacts).
+// Loops index the box axes by number, as the WGSL twin does, step for step.
+#![allow(clippy::needless_range_loop)]
 
 use glam::{Mat3, Quat, Vec3};
 
