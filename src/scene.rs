@@ -1616,15 +1616,16 @@ mod tests {
         assert_eq!(e.field(), Some("bodies[0].orientation[1]"));
         assert!(e.to_string().contains("got NaN"), "{e}");
 
-        // Extreme but individually valid values that overflow the inertia.
+        // Extreme but individually valid values that overflow the inverse
+        // inertia (a body that small is refused for its size first).
         let mut scene = Scene::default();
         let mut body = Body::new(
             Shape::Box {
-                half_extents: [1e-30; 3],
+                half_extents: [0.5; 3],
             },
             [0.0; 3],
         );
-        body.mass = 1e-30;
+        body.mass = 1e-44;
         scene.bodies.push(body);
         assert_eq!(
             scene.validate().unwrap_err().field(),
