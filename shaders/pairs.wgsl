@@ -179,12 +179,16 @@ fn walk(i: u32) {
     }
 }
 
+// Both walks take the bodies in grid order (sorted: by cell, then the large
+// bodies), so the invocations packed into one vector walk the same cells
+// and their loops run the same number of times; what each body finds, and
+// where it is written, does not depend on which invocation walks it.
 @compute @workgroup_size(WORKGROUP)
 fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= params.body_count) {
+    if (gid.x >= params.body_count) {
         return;
     }
+    let i = sorted[gid.x];
     writing = false;
     walk(i);
     pair_meta[i].owned = owned;
@@ -192,12 +196,11 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 @compute @workgroup_size(WORKGROUP)
 fn pairs_write(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= params.body_count) {
+    if (gid.x >= params.body_count) {
         return;
     }
     writing = true;
-    walk(i);
+    walk(sorted[gid.x]);
 }
 
 @compute @workgroup_size(WORKGROUP)
