@@ -32,7 +32,7 @@ macro_rules! check_layout {
 #[test]
 fn shared_structs_match_member_by_member() {
     let common = &format!("{}{}", shaders::COMMON, shaders::BINDINGS);
-    check_layout!(common, BodyState { pos, prev_pos, rot, prev_rot });
+    check_layout!(common, BodyState { pos, disp, pos_low, rot, prev_rot });
     check_layout!(common, BodyProps { half_extents, inv_inertia, material, kind });
     check_layout!(common, Velocity { linear, angular });
     check_layout!(
