@@ -86,7 +86,7 @@ struct Params {
     step_index: u32,         // the world's step count as this step began (saturates at NO_FAULT - 1)
     sleep_after: f32,        // seconds at rest before a body sleeps; 0: never (settings.sleeping)
     substep: u32,            // which substep of the step this is (0 first)
-    _pad3: u32,
+    opaque_zero: u32,        // always 0; see `opaque` (integrate.wgsl)
     _pad4: u32,
     _pad5: u32,
 }

@@ -108,6 +108,13 @@ fn report_fault(i: u32, fault: u32) {
     }
 }
 
+// v, behind a barrier the shader compiler cannot see through: a driver may
+// simplify float arithmetic not marked exact (naga marks none), and Mesa's
+// optimiser folds (a + b) - a to b, which turns TwoSum's remainder into 0.
+fn opaque(v: vec3<f32>) -> vec3<f32> {
+    return bitcast<vec3<f32>>(bitcast<vec3<u32>>(v) ^ vec3<u32>(params.opaque_zero));
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -179,8 +186,8 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     // about 1/1000 of its f32 spacing instead of losing up to half a
     // spacing every substep
     let add = disp + pos_remainder(s);
-    let pos = s.pos.xyz + add;
-    let add_part = pos - s.pos.xyz;
+    let pos = opaque(s.pos.xyz + add);
+    let add_part = opaque(pos - s.pos.xyz);
     let pos_part = pos - add_part;
     let dropped = (s.pos.xyz - pos_part) + (add - add_part);
 

@@ -548,6 +548,7 @@ impl World {
                     step_index,
                     sleep_after: if s.sleeping { crate::scene::SLEEP_AFTER } else { 0.0 },
                     substep: substep as u32,
+                    opaque_zero: 0,
                     ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;

@@ -133,7 +133,8 @@ fn velocities_read_back_at_the_steps_time() {
         let err = (v3(s[k].linear_velocity) - v3(*v)).length();
         assert!(err < 1e-5, "body {k} given {v:?} reads {:?} at step 0", s[k].linear_velocity);
     }
-    assert_eq!(s[3].linear_velocity, [0.0; 3], "a body given no velocity reads none at step 0");
+    // (f32: the displacement -g h^2 / 2 is stored rounded)
+    assert!(v3(s[3].linear_velocity).length() < 1e-6, "a body given no velocity reads {:?} at step 0", s[3].linear_velocity);
     assert_eq!(s[4].linear_velocity, [0.0; 3], "a fixed body reads no velocity");
     let g = DVec3::from_array(scene.settings.gravity.map(|v| v as f64));
     let mut worst = 0.0f64;

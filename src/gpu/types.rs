@@ -84,7 +84,10 @@ pub struct Params {
     pub sleep_after: f32,
     /// Which substep of the step this is (0 first): sleepers wake only at 0.
     pub substep: u32,
-    pub _pad3: u32,
+    /// Always 0, but unknown to the shader compiler: integrate XORs a sum's
+    /// bits with it so that the driver cannot fold TwoSum's `(a + b) - a`
+    /// back to `b` (Mesa's optimiser does, for operations not marked exact).
+    pub opaque_zero: u32,
     pub _pad4: u32,
     pub _pad5: u32,
 }
