@@ -4,11 +4,51 @@
 
 // Pose of one body: what swaps between the two state buffers every pass.
 // 64 bytes. Quaternions are (x, y, z, w).
+//
+// The translation is kept as the displacement x_n - x_(n-1) rather than the
+// previous position: the same Verlet algebra, but the velocity disp / h no
+// longer comes from the difference of two large numbers (in f32 a position
+// near 100 m is held to 8e-6 m, while gravity adds g h^2 = 3e-4 m per
+// substep: a projectile 100 m up strayed 15 cm from its parabola in 2 s).
+// Every snap that moves pos moves disp with it, as moving pos while the
+// previous position stayed did. `pos_low` keeps what rounding dropped from
+// pos when integrate added the displacement (see `pos_remainder`): at 1 km
+// the f32 grid is 6e-5 m, and a steady horizontal displacement rounded the
+// same way every substep (21 mm in 2 s at 8 substeps).
 struct BodyState {
     pos: vec4<f32>,      // xyz = centre of mass (m); w = seconds at rest (see `asleep`)
-    prev_pos: vec4<f32>, // xyz = centre of mass one step ago; w = 1 if a contact pushed it then
+    disp: vec3<f32>,     // x_n - x_(n-1): how far the centre moved over the last substep (m)
+    pos_low: u32,        // bits 0-29: pos's rounding remainder (`pos_remainder`); bit 31: HELD
     rot: vec4<f32>,      // orientation, unit quaternion
     prev_rot: vec4<f32>, // orientation one step ago
+}
+
+// BodyState.pos_low bit 31: something besides gravity held the body over
+// the last substep: a contact pushed it (the solve sets it; integrate's
+// test for sleeping reads it), or it is fixed or asleep. The host then
+// reports disp / h as its velocity, without the half substep of gravity
+// that a free body's disp / h lags by (World::read_state).
+const HELD: u32 = 0x80000000u;
+
+// One step of pos_remainder's grid for a coordinate x (m): 1/512 of x's f32
+// spacing, floored at 2^-92 m so that it never underflows.
+fn remainder_unit(x: vec3<f32>) -> vec3<f32> {
+    let exponent = max(bitcast<vec3<u32>>(x) & vec3<u32>(0x7f800000u), vec3<u32>(0x21800000u));
+    return bitcast<vec3<f32>>(exponent) * 2.3283064e-10; // 2^-32 = 2^-23 / 512
+}
+
+// What rounding dropped from pos.xyz (m): the true centre is pos + this.
+// Each coordinate is a signed 10-bit multiple of remainder_unit (bits 0-9 x,
+// 10-19 y, 20-29 z, offset by 512), so it holds about 1/1000 of a spacing.
+fn pos_remainder(s: BodyState) -> vec3<f32> {
+    let q = (vec3<u32>(s.pos_low) >> vec3<u32>(0u, 10u, 20u)) & vec3<u32>(0x3ffu);
+    return (vec3<f32>(q) - 512.0) * remainder_unit(s.pos.xyz);
+}
+
+// pos_low for a remainder r (m) of the position x, with the HELD bit of `flags`.
+fn pack_remainder(r: vec3<f32>, x: vec3<f32>, flags: u32) -> u32 {
+    let q = vec3<u32>(vec3<i32>(clamp(round(r / remainder_unit(x)), vec3<f32>(-511.0), vec3<f32>(511.0))) + 512);
+    return q.x | (q.y << 10u) | (q.z << 20u) | (flags & HELD);
 }
 
 // What rarely changes: shape, mass and material. 64 bytes.
@@ -30,7 +70,7 @@ struct Velocity {
 struct Params {
     gravity: vec4<f32>,      // xyz (m/s^2); w = ground height (m)
     dt: f32,                 // this step (s)
-    dt_prev: f32,            // the step that produced pos - prev_pos (s)
+    dt_prev: f32,            // the step that produced disp (s)
     relaxation: f32,         // the paper's c_r
     linear_damping: f32,     // the paper's beta, per step
     angular_damping: f32,    // beta for rotation, per step
@@ -46,7 +86,7 @@ struct Params {
     step_index: u32,         // the world's step count as this step began (saturates at NO_FAULT - 1)
     sleep_after: f32,        // seconds at rest before a body sleeps; 0: never (settings.sleeping)
     substep: u32,            // which substep of the step this is (0 first)
-    _pad3: u32,
+    opaque_zero: u32,        // always 0; see `opaque` (integrate.wgsl)
     _pad4: u32,
     _pad5: u32,
 }
@@ -294,14 +334,15 @@ fn wakes(j: u32, gap: f32) -> bool {
 // (m/s): the centre's speed plus the spin times the bounding radius.
 fn point_speed(s: BodyState, p: BodyProps) -> f32 {
     let spin = length(quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))));
-    return (length(s.pos.xyz - s.prev_pos.xyz) + spin * p.half_extents.w) / params.dt_prev;
+    return (length(s.disp) + spin * p.half_extents.w) / params.dt_prev;
 }
 
-// One body of a contact manifold as the contact passes see it: its poses,
+// One body of a contact manifold as the contact passes see it: its poses
+// (the current one and how it got there from the previous),
 // masses and material; the ground is an end at the origin with no mass.
 struct ContactEnd {
     pos: vec3<f32>,
-    prev_pos: vec3<f32>,
+    disp: vec3<f32>,        // x_n - x_(n-1) (m), see BodyState
     rot: vec4<f32>,
     prev_rot: vec4<f32>,
     inv_inertia: vec4<f32>, // xyz body frame (1/(kg m^2)); w = inverse mass (1/kg)
@@ -318,7 +359,7 @@ fn contact_end(i: u32) -> ContactEnd {
     }
     let s = state_in[i];
     let p = props[i];
-    return ContactEnd(s.pos.xyz, s.prev_pos.xyz, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
+    return ContactEnd(s.pos.xyz, s.disp, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
                       p.material.x, p.material.y);
 }
 

@@ -50,7 +50,7 @@ fn reach_of(i: u32) -> f32 {
     let steps = f32(params.substeps);
     let ratio = params.dt / params.dt_prev * steps;
     let h = params.dt * steps;
-    return length(s.pos.xyz - s.prev_pos.xyz) * ratio + length(params.gravity.xyz) * h * h;
+    return length(s.disp) * ratio + length(params.gravity.xyz) * h * h;
 }
 
 // Half extents of body i's world box: |R| h for a box, the radius for a sphere.

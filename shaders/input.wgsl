@@ -6,8 +6,9 @@
 // common.wgsl and bindings.wgsl, but it binds only state_out (the current
 // state buffer, rewritten in place) and what it declares below; and Verlet's velocity is
 // implicit, so a change of velocity is a change of the previous pose:
-// v = (pos - prev_pos) / h and the turn rot * prev_rot^* = exp(w h), where h
-// is the substep that produced them (input.gravity.w).
+// v = disp / h (disp = x_n - x_(n-1), see BodyState) and the turn
+// rot * prev_rot^* = exp(w h), where h is the substep that produced them
+// (input.gravity.w).
 
 struct InputHeader {
     gravity: vec4<f32>, // xyz = settings.gravity (m/s^2); w = h, the last substep (s)
@@ -77,7 +78,7 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 return s;
             }
             let j = op.a.xyz;
-            s.prev_pos = vec4<f32>(s.prev_pos.xyz - j * (p.inv_inertia.w * h), s.prev_pos.w);
+            s.disp = s.disp + j * (p.inv_inertia.w * h);
             var r = vec3<f32>(0.0);
             if (op.a.w == 1.0) {
                 r = op.b.xyz - s.pos.xyz;
@@ -90,16 +91,15 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             }
         }
         case INPUT_POSE: {
-            let moved = s.pos.xyz - s.prev_pos.xyz;
             let turn = quat_mul(s.rot, quat_conj(s.prev_rot));
             let q = op.b;
             s.pos = vec4<f32>(op.a.xyz, s.pos.w);
+            s.pos_low = s.pos_low & HELD; // the new position is exact
             s.rot = q;
             if (fixed) {
-                s.prev_pos = s.pos;
+                s.disp = vec3<f32>(0.0);
                 s.prev_rot = q;
             } else {
-                s.prev_pos = vec4<f32>(op.a.xyz - moved, s.prev_pos.w);
                 s.prev_rot = normalize(quat_mul(quat_conj(turn), q));
             }
         }
@@ -107,9 +107,14 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             if (fixed) {
                 return s;
             }
-            // as the scene loader does: the next steps follow x + v t + g t^2 / 2
+            // as the scene loader does: the next steps follow x + v t + g t^2 / 2,
+            // and the velocity reads back as v (the host adds the half
+            // substep of gravity that disp / h lags by, see body_output,
+            // for a body no contact pressed: given a velocity, it is not
+            // known to rest on anything)
             let v = op.a.xyz;
-            s.prev_pos = vec4<f32>(s.pos.xyz - v * h + 0.5 * input.gravity.xyz * (h * h), s.prev_pos.w);
+            s.disp = v * h - 0.5 * input.gravity.xyz * (h * h);
+            s.pos_low = s.pos_low & ~HELD;
             s.prev_rot = prev_rot_for_spin(s.rot, op.b.xyz, h);
         }
         case INPUT_FIXED: {
@@ -120,7 +125,8 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 }
                 np.kind.y = p.kind.y | FLAG_FIXED;
                 np.inv_inertia = vec4<f32>(0.0);
-                s.prev_pos = s.pos;
+                s.disp = vec3<f32>(0.0);
+                s.pos_low = s.pos_low | HELD;
                 s.prev_rot = s.rot;
             } else if (fixed) {
                 var m = op.a.y;
@@ -132,7 +138,8 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 np.material.z = 0.0;
                 // at rest, as the scene loader starts a body: the next steps
                 // follow x + g t^2 / 2
-                s.prev_pos = vec4<f32>(s.pos.xyz + 0.5 * input.gravity.xyz * (h * h), s.pos.w);
+                s.disp = -0.5 * input.gravity.xyz * (h * h);
+                s.pos_low = s.pos_low & ~HELD;
                 s.prev_rot = s.rot;
             }
             *p_in = np;
@@ -209,7 +216,7 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
         scale = pow(base, input.reach.y);
     }
     let dv = dir * (input.centre.w * scale * p.inv_inertia.w);
-    s.prev_pos = vec4<f32>(s.prev_pos.xyz - dv * input.gravity.w, s.prev_pos.w);
+    s.disp = s.disp + dv * input.gravity.w;
     state_out[i] = s;
 }
 
@@ -238,7 +245,7 @@ fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var s = state_out[i];
     let h = input.gravity.w;
-    let v = (s.pos.xyz - s.prev_pos.xyz) / h;
+    let v = s.disp / h;
     let rel = input.centre.xyz - v; // wind relative to the body
     let speed = length(rel);
     if (speed == 0.0) {
@@ -247,6 +254,6 @@ fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = input.centre.w * projected_area(p, s.rot, rel / speed) * p.inv_inertia.w;
     let left = rel / (1.0 + k * speed * input.reach.x);
     let dv = rel - left;
-    s.prev_pos = vec4<f32>(s.prev_pos.xyz - dv * h, s.prev_pos.w);
+    s.disp = s.disp + dv * h;
     state_out[i] = s;
 }

@@ -5,22 +5,23 @@
 //
 // Numerical faults: first, every body's state as read here is checked, every
 // substep, with no readback. A body whose pose is not finite (an infinity or
-// a NaN in pos, prev_pos, rot or prev_rot), lies farther than MAX_DISTANCE
+// a NaN in pos, disp, rot or prev_rot), lies farther than MAX_DISTANCE
 // from the origin, moved faster than MAX_SPEED or turned faster than MAX_SPIN
 // (or more than MAX_TURN) over the last substep is
 // flagged in status[2..4] (bindings.wgsl: the lowest such body of the first
 // step that found any, with that step's index) and stopped: it is parked at
 // rest at its last sane pose (its current one if that is finite and within
-// MAX_DISTANCE, else its previous one, which passed this check last time
-// unless an input wrote it, else the origin; its rotation likewise, else
-// none) and the step goes on; the next substep integrates it again from
+// MAX_DISTANCE, else its previous one, pos - disp, which passed this check
+// last time unless an input wrote it, else its current one with each
+// coordinate that is not finite set to 0, else the origin; its rotation
+// likewise, else none) and the step goes on; the next substep integrates it again from
 // rest. Nothing else changes, so a run with no fault is bit-identical to one
 // without the check. The host reads the flag only on request
 // (World::faults, World::read_state), never in the step loop.
 
 // Sleeping (see `asleep` in common.wgsl): a body sleeps once it has moved
 // slower than SLEEP_SPEED, at every point, for params.sleep_after seconds
-// while touching something (the solve leaves 1 in prev_pos.w when a contact
+// while touching something (the solve sets HELD in pos_low when a contact
 // of the body pushed in the substep); a sleeper wakes when an awake body in
 // a pair with it moves faster than WAKE_SPEED at any point or lies more
 // than WAKE_DEPTH inside it (`wakes`, found by the narrowphase; the body
@@ -76,7 +77,7 @@ fn usable_rotation(q: vec4<f32>) -> bool {
 
 // FAULT_* of a body's state, or NO_FAULT.
 fn fault_of(s: BodyState) -> u32 {
-    let finite = all_finite(vec4<f32>(s.pos.xyz, 0.0)) && all_finite(vec4<f32>(s.prev_pos.xyz, 0.0))
+    let finite = all_finite(vec4<f32>(s.pos.xyz, 0.0)) && all_finite(vec4<f32>(s.disp, 0.0))
         && all_finite(s.rot) && all_finite(s.prev_rot);
     if (!finite) {
         return FAULT_NON_FINITE;
@@ -84,7 +85,7 @@ fn fault_of(s: BodyState) -> u32 {
     if (!near(s.pos)) {
         return FAULT_FAR;
     }
-    let moved = s.pos.xyz - s.prev_pos.xyz;
+    let moved = s.disp;
     let reach = MAX_SPEED * params.dt_prev;
     if (dot(moved, moved) > reach * reach) {
         return FAULT_FAST;
@@ -107,6 +108,13 @@ fn report_fault(i: u32, fault: u32) {
     }
 }
 
+// v, behind a barrier the shader compiler cannot see through: a driver may
+// simplify float arithmetic not marked exact (naga marks none), and Mesa's
+// optimiser folds (a + b) - a to b, which turns TwoSum's remainder into 0.
+fn opaque(v: vec3<f32>) -> vec3<f32> {
+    return bitcast<vec3<f32>>(bitcast<vec3<u32>>(v) ^ vec3<u32>(params.opaque_zero));
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -121,10 +129,16 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (fault != NO_FAULT) {
         report_fault(i, fault);
         var at = vec3<f32>(0.0);
+        let prev = vec4<f32>(s.pos.xyz - s.disp, 0.0);
+        // the current position's finite coordinates (a NaN in one of them
+        // leaves pos - disp no better)
+        let kept = select(vec3<f32>(0.0), s.pos.xyz, (bitcast<vec3<u32>>(s.pos.xyz) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u));
         if (near(s.pos)) {
             at = s.pos.xyz;
-        } else if (near(s.prev_pos)) {
-            at = s.prev_pos.xyz;
+        } else if (near(prev)) {
+            at = prev.xyz;
+        } else if (near(vec4<f32>(kept, 0.0))) {
+            at = kept;
         }
         var q = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         if (usable_rotation(s.rot)) {
@@ -132,12 +146,12 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         } else if (usable_rotation(s.prev_rot)) {
             q = normalize(s.prev_rot);
         }
-        state_out[i] = BodyState(vec4<f32>(at, 0.0), vec4<f32>(at, 0.0), q, q);
+        state_out[i] = BodyState(vec4<f32>(at, 0.0), vec3<f32>(0.0), 0u, q, q);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
     if (is_fixed(p)) {
-        state_out[i] = BodyState(s.pos, s.pos, s.rot, s.rot);
+        state_out[i] = BodyState(s.pos, vec3<f32>(0.0), HELD, s.rot, s.rot);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
@@ -148,24 +162,34 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (!wake) {
                 rest = s.pos.w;
             }
-        } else if (s.prev_pos.w > 0.0 && joint_start[i] == joint_start[i + 1u] && point_speed(s, p) < SLEEP_SPEED) {
+        } else if ((s.pos_low & HELD) != 0u && joint_start[i] == joint_start[i + 1u] && point_speed(s, p) < SLEEP_SPEED) {
             rest = s.pos.w + dt;
         }
     }
     if (rest >= params.sleep_after && rest > 0.0) {
-        // asleep: held still where it is
-        state_out[i] = BodyState(vec4<f32>(s.pos.xyz, rest), s.pos, s.rot, s.rot);
+        // asleep: held still where it is (resting on what pressed it)
+        state_out[i] = BodyState(vec4<f32>(s.pos.xyz, rest), vec3<f32>(0.0), s.pos_low | HELD, s.rot, s.rot);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
     // eq. 11: the last displacement, rescaled to this step's length
     let ratio = dt / params.dt_prev;
     // eq. 12: damping keeps (1 - beta) of it
-    let carry = (s.pos.xyz - s.prev_pos.xyz) * (ratio * (1.0 - params.linear_damping));
+    let carry = s.disp * (ratio * (1.0 - params.linear_damping));
     // constant acceleration: a dt (dt + dt_prev) / 2 is exact for any pair of
     // steps and equals eq. 6's a dt^2 when dt does not change
     let accel = params.gravity.xyz * (dt * 0.5 * (dt + params.dt_prev));
-    let pos = s.pos.xyz + carry + accel;
+    let disp = carry + accel;
+    // pos + disp, with what the last addition's rounding dropped added back
+    // and what this one drops kept (Knuth's TwoSum, exact under
+    // round-to-nearest): the position then follows the displacements to
+    // about 1/1000 of its f32 spacing instead of losing up to half a
+    // spacing every substep
+    let add = disp + pos_remainder(s);
+    let pos = opaque(s.pos.xyz + add);
+    let add_part = opaque(pos - s.pos.xyz);
+    let pos_part = pos - add_part;
+    let dropped = (s.pos.xyz - pos_part) + (add - add_part);
 
     // eq. 7 with no torque: repeat the last rotation q_n q_{n-1}^*, scaled by
     // the step ratio and damped by interpolation towards no rotation
@@ -178,6 +202,6 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rot = normalize(quat_mul(turn, s.rot));
     let spin = quat_to_rotvec(turn);
 
-    state_out[i] = BodyState(vec4<f32>(pos, rest), s.pos, rot, s.rot);
-    vel0[i] = Velocity(vec4<f32>((pos - s.pos.xyz) / dt, 0.0), vec4<f32>(spin / dt, 0.0));
+    state_out[i] = BodyState(vec4<f32>(pos, rest), disp, pack_remainder(dropped, pos, s.pos_low), rot, s.rot);
+    vel0[i] = Velocity(vec4<f32>(disp / dt, 0.0), vec4<f32>(spin / dt, 0.0));
 }

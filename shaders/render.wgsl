@@ -21,7 +21,8 @@
 // on the step's bindings (tests/render.rs checks the two stay alike).
 struct BodyState {
     pos: vec4<f32>,
-    prev_pos: vec4<f32>,
+    disp: vec3<f32>,
+    pos_low: u32,
     rot: vec4<f32>,
     prev_rot: vec4<f32>,
 }

@@ -1,5 +1,6 @@
 // Passes "restitution_contacts" and "restitution", once per substep after
-// the solve: collisions change velocity by rewriting the previous pose (the paper, section III). A contact
+// the solve: collisions change velocity by rewriting the previous pose (the paper, section III;
+// here the displacement from it and the previous rotation). A contact
 // that was approaching faster than a resting contact can (2 |g| dt), and
 // faster than RESTITUTION_THRESHOLD, leaves with -e times its approach speed
 // along the normal; slower ones stay at rest, so resting bodies do not hop.
@@ -17,9 +18,9 @@
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
 
-// Velocities a pose implies: (x - x_prev) / dt and the rotation q q_prev^*.
-fn pose_velocity(pos: vec3<f32>, prev_pos: vec3<f32>, rot: vec4<f32>, prev_rot: vec4<f32>) -> Velocity {
-    let v = (pos - prev_pos) / params.dt;
+// Velocities a pose implies: disp / dt (disp = x - x_prev) and the rotation q q_prev^*.
+fn pose_velocity(disp: vec3<f32>, rot: vec4<f32>, prev_rot: vec4<f32>) -> Velocity {
+    let v = disp / params.dt;
     let w = quat_to_rotvec(quat_mul(rot, quat_conj(prev_rot))) / params.dt;
     return Velocity(vec4<f32>(v, 0.0), vec4<f32>(w, 0.0));
 }
@@ -33,7 +34,7 @@ fn end_velocity(i: u32, e: ContactEnd) -> Velocity {
     if (i == GROUND) {
         return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
     }
-    return pose_velocity(e.pos, e.prev_pos, e.rot, e.prev_rot);
+    return pose_velocity(e.disp, e.rot, e.prev_rot);
 }
 
 // ... and before it (integrate's vel0).
@@ -143,10 +144,10 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     dw = dw / f32(max(acting, 1u));
     if (any(dv != vec3<f32>(0.0)) || any(dw != vec3<f32>(0.0))) {
-        let now = pose_velocity(s.pos.xyz, s.prev_pos.xyz, s.rot, s.prev_rot);
+        let now = pose_velocity(s.disp, s.rot, s.prev_rot);
         let v = now.linear.xyz + dv;
         let w = now.angular.xyz + dw;
-        s.prev_pos = vec4<f32>(s.pos.xyz - v * params.dt, s.prev_pos.w);
+        s.disp = v * params.dt;
         s.prev_rot = normalize(quat_mul(quat_from_rotvec(-w * params.dt), s.rot));
     }
     state_out[i] = s;

@@ -67,15 +67,17 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
         let rb = quat_rotate(eb.rot, pt.local_b);
         let on_a = ea.pos + ra;
         let on_b = eb.pos + rb;
-        let before_a = ea.prev_pos + quat_rotate(ea.prev_rot, pt.local_a);
-        let before_b = eb.prev_pos + quat_rotate(eb.prev_rot, pt.local_b);
+        // how far each material point moved since the previous poses, from
+        // the displacements (no difference of two far-out positions)
+        let moved_a = ea.disp + (ra - quat_rotate(ea.prev_rot, pt.local_a));
+        let moved_b = eb.disp + (rb - quat_rotate(eb.prev_rot, pt.local_b));
         // Overlap the bodies already had at their previous poses is pushed
         // out at no more than MAX_DEPENETRATION_SPEED: a full snap in one
         // substep would turn into that much velocity (Verlet), and deep
         // overlaps (thin limbs passing through each other, bodies placed
         // overlapping) launched bodies at tens of m/s. Overlap made by this
         // substep's approach is removed whole.
-        let overlap_before = dot(before_a - before_b, n);
+        let overlap_before = dot((on_a - moved_a) - (on_b - moved_b), n);
         let depth = dot(on_a - on_b, n) - max(overlap_before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
         // a contact that pushed earlier in this substep keeps its friction
         // while it still touches, even once its depth is resolved, so
@@ -94,7 +96,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         if (depth > 0.0 || (pt.pushed > 0.0 && depth >= -CONTACT_SLOP)) {
             // how far a's point slid against b's since the previous poses
-            let slip = (on_a - before_a) - (on_b - before_b);
+            let slip = moved_a - moved_b;
             let slip_t = slip - n * dot(slip, n);
             let slide = length(slip_t);
             if (slide > 1e-9 && slide <= mu * (pt.pushed + push)) {
@@ -191,8 +193,12 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // solve_contacts) and the partners' turns are averaged too (mass
     // splitting, for the inertia only: translations are scaled per partner).
     let split = 1.0 / f32(max(touching, 1u));
-    s.pos = vec4<f32>(s.pos.xyz + acc.dx * params.relaxation, s.pos.w);
-    s.prev_pos.w = f32(pressed);
+    // a snap moves the displacement with the pose: the velocity changes by
+    // dx / h, as Verlet's moving x_n while x_(n-1) stays does
+    let dx = acc.dx * params.relaxation;
+    s.pos = vec4<f32>(s.pos.xyz + dx, s.pos.w);
+    s.disp = s.disp + dx;
+    s.pos_low = (s.pos_low & ~HELD) | select(0u, HELD, pressed != 0u);
     s.rot = quat_add_rotation(s.rot, acc.dtheta * (params.relaxation * split));
     state_out[i] = s;
 }

@@ -23,7 +23,8 @@ pub struct BodyOutput {
     pub position: [f32; 3],
     /// Unit quaternion (x, y, z, w).
     pub orientation: [f32; 4],
-    /// Velocities implied by Verlet: (current - previous) / dt (m/s).
+    /// Velocity at the step's time (m/s), from Verlet's displacement (see
+    /// [`body_output`]).
     pub linear_velocity: [f32; 3],
     /// World frame (rad/s).
     pub angular_velocity: [f32; 3],
@@ -283,7 +284,7 @@ pub struct World {
     current: usize,
     step: u64,
     time: f64,
-    /// Length of the last (sub)step taken (s): what `pos - prev_pos` spans.
+    /// Length of the last (sub)step taken (s): what `disp` spans.
     dt_prev: f32,
     /// The user-input kernels (`input.rs`), built on the first input.
     input: Option<input::InputGpu>,
@@ -547,6 +548,7 @@ impl World {
                     step_index,
                     sleep_after: if s.sleeping { crate::scene::SLEEP_AFTER } else { 0.0 },
                     substep: substep as u32,
+                    opaque_zero: 0,
                     ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;
@@ -785,7 +787,16 @@ impl World {
         if let Some(fault) = self.faults()? {
             return Err(Error::Diverged(fault.to_string()));
         }
-        let out: Vec<BodyOutput> = states.iter().map(|s| body_output(s, dt)).collect();
+        let mut joined = vec![false; states.len()];
+        for j in &self.scene.joints {
+            for b in j.bodies {
+                if let Some(k) = usize::try_from(b).ok().filter(|&k| k < joined.len()) {
+                    joined[k] = true;
+                }
+            }
+        }
+        let gravity = self.settings.gravity;
+        let out: Vec<BodyOutput> = states.iter().zip(&joined).map(|(s, &j)| body_output(s, dt, gravity, j)).collect();
         if let Some(k) = out.iter().position(|b| !finite_output(b)) {
             return Err(Error::Diverged(format!(
                 "body {k} has a non-finite state after step {} (time {:.4} s)",
@@ -831,9 +842,26 @@ fn dquat(v: [f32; 4]) -> DQuat {
     DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64)
 }
 
-/// Velocities the Verlet state implies: (current - previous) / dt.
-pub fn body_output(s: &BodyState, dt: f64) -> BodyOutput {
-    let v = (dvec(s.pos) - dvec(s.prev_pos)) / dt;
+/// What a user sees of a body: its pose and its velocities at the step's
+/// time, from a Verlet state whose last substep took `dt` s.
+///
+/// The displacement `disp = x_n - x_(n-1)` over `dt` is the mean velocity
+/// over the last substep, the velocity half a substep ago: reported as it
+/// is, a body given zero velocity read `-g dt / 2` (0.027 m/s upward at the
+/// default settings) at step 0. The velocity at the step's time is
+/// `disp / dt + a dt / 2` with `a` the acceleration at that time, exact for
+/// a constant one (`initial_state` sets `disp = v0 dt - g dt^2 / 2`, so step
+/// 0 reads v0 back, and free fall reads v0 + g t at every step). A free body
+/// accelerates at `gravity`; one that something held over the last substep
+/// (a contact pushed it, it is fixed or asleep: `HELD`) or that hangs on a
+/// joint is not known to, and resting on the ground it accelerates at none,
+/// so it reads `disp / dt`, which is 0 at rest. Angular velocity has no
+/// acceleration to correct (no torques): the last substep's turn over dt.
+pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> BodyOutput {
+    let free = s.pos_low & HELD == 0 && !joined;
+    let half_step = if free { DVec3::from_array(gravity.map(|g| g as f64)) * (0.5 * dt) } else { DVec3::ZERO };
+    let disp = DVec3::new(s.disp[0] as f64, s.disp[1] as f64, s.disp[2] as f64);
+    let v = disp / dt + half_step;
     let mut dq = dquat(s.rot) * dquat(s.prev_rot).conjugate();
     if dq.w < 0.0 {
         dq = -dq;
@@ -925,25 +953,34 @@ pub fn body_props(b: &Body, settings: &Settings) -> BodyProps {
     }
 }
 
-/// The starting pose, with the previous pose set so that the first Verlet
-/// step reproduces the initial velocities exactly: x_prev = x0 - v0 h + g h^2/2
-/// makes x1 = x0 + v0 h + g h^2/2, and Verlet then stays on the parabola.
+/// The starting pose, with the displacement from the previous pose set so
+/// that the first Verlet step reproduces the initial velocities exactly:
+/// disp = x0 - x_prev = v0 h - g h^2/2 makes x1 = x0 + v0 h + g h^2/2, and
+/// Verlet then stays on the parabola. A fixed body is `HELD` (see
+/// [`body_output`]); no rounding remainder yet (x0 is exact).
 pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
     let x0 = DVec3::from_array(b.position.map(|v| v as f64));
     let o = b.orientation;
     let q0 = DQuat::from_xyzw(o[0] as f64, o[1] as f64, o[2] as f64, o[3] as f64).normalize();
-    let (prev, prev_q) = if b.fixed {
-        (x0, q0)
+    let (disp, prev_q) = if b.fixed {
+        (DVec3::ZERO, q0)
     } else {
         let h = (settings.dt / settings.substeps as f32) as f64;
         let v0 = DVec3::from_array(b.linear_velocity.map(|v| v as f64));
         let w0 = DVec3::from_array(b.angular_velocity.map(|v| v as f64));
         let g = DVec3::from_array(settings.gravity.map(|v| v as f64));
-        (x0 - v0 * h + 0.5 * g * h * h, (DQuat::from_scaled_axis(-w0 * h) * q0).normalize())
+        (v0 * h - 0.5 * g * h * h, (DQuat::from_scaled_axis(-w0 * h) * q0).normalize())
     };
-    let v4 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+    let v3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
     let q4 = |q: DQuat| [q.x as f32, q.y as f32, q.z as f32, q.w as f32];
-    BodyState { pos: v4(x0), prev_pos: v4(prev), rot: q4(q0), prev_rot: q4(prev_q) }
+    let x = v3(x0);
+    BodyState {
+        pos: [x[0], x[1], x[2], 0.0],
+        disp: v3(disp),
+        pos_low: if b.fixed { HELD } else { 0 },
+        rot: q4(q0),
+        prev_rot: q4(prev_q),
+    }
 }
 
 fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {

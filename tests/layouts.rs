@@ -32,7 +32,7 @@ macro_rules! check_layout {
 #[test]
 fn shared_structs_match_member_by_member() {
     let common = &format!("{}{}", shaders::COMMON, shaders::BINDINGS);
-    check_layout!(common, BodyState { pos, prev_pos, rot, prev_rot });
+    check_layout!(common, BodyState { pos, disp, pos_low, rot, prev_rot });
     check_layout!(common, BodyProps { half_extents, inv_inertia, material, kind });
     check_layout!(common, Velocity { linear, angular });
     check_layout!(
@@ -40,7 +40,7 @@ fn shared_structs_match_member_by_member() {
         Params {
             gravity, dt, dt_prev, relaxation, linear_damping, angular_damping, body_count, has_ground,
             ground_restitution, ground_friction, cell_size, hash_size, large_count, speculative,
-            substeps, step_index, sleep_after, substep, _pad3, _pad4, _pad5
+            substeps, step_index, sleep_after, substep, opaque_zero, _pad4, _pad5
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });

@@ -133,8 +133,8 @@ fn bad_files_are_refused_with_a_reason() {
         ("padded", [good.clone(), vec![0; 64]].concat(), "bodies should be"),
     ];
     let mut version = good.clone();
-    version[8] = 2;
-    cases.push(("version", version, "version 2"));
+    version[8] = 3; // versions 1 (converted) and 2 are read
+    cases.push(("version", version, "version 3"));
     let mut flipped = good.clone();
     flipped[100] ^= 1;
     cases.push(("bit flip", flipped, "corrupt"));

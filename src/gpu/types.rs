@@ -8,15 +8,27 @@ use bytemuck::{Pod, Zeroable};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BodyState {
-    /// xyz = centre of mass (m); w unused.
+    /// xyz = centre of mass (m); w = seconds at rest (see `asleep` in common.wgsl).
     pub pos: [f32; 4],
-    /// Centre of mass one step ago (m).
-    pub prev_pos: [f32; 4],
+    /// x_n - x_(n-1): how far the centre moved over the last substep (m).
+    /// Verlet's velocity is `disp / h`; kept instead of the previous position
+    /// so that it is not the difference of two large numbers.
+    pub disp: [f32; 3],
+    /// Bits 0-29: what rounding dropped from `pos` (three signed 10-bit
+    /// multiples of 1/512 of each coordinate's f32 spacing, see
+    /// `pos_remainder` in common.wgsl); bit 31 ([`HELD`]): something besides
+    /// gravity held the body over the last substep (a contact, or it is
+    /// fixed or asleep).
+    pub pos_low: u32,
     /// Orientation, unit quaternion (x, y, z, w).
     pub rot: [f32; 4],
     /// Orientation one step ago.
     pub prev_rot: [f32; 4],
 }
+
+/// `BodyState::pos_low` bit: something besides gravity held the body over
+/// the last substep: a contact pushed it, or it is fixed or asleep.
+pub const HELD: u32 = 0x8000_0000;
 
 /// Shape, mass and material of one body (64 bytes), read-only on the GPU.
 #[repr(C)]
@@ -72,7 +84,10 @@ pub struct Params {
     pub sleep_after: f32,
     /// Which substep of the step this is (0 first): sleepers wake only at 0.
     pub substep: u32,
-    pub _pad3: u32,
+    /// Always 0, but unknown to the shader compiler: integrate XORs a sum's
+    /// bits with it so that the driver cannot fold TwoSum's `(a + b) - a`
+    /// back to `b` (Mesa's optimiser does, for operations not marked exact).
+    pub opaque_zero: u32,
     pub _pad4: u32,
     pub _pad5: u32,
 }

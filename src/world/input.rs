@@ -19,7 +19,8 @@
 //! inputs to the same body compose without races.
 //!
 //! Velocity changes rewrite the previous pose: with h the substep that
-//! produced the current pose, v = (pos - prev_pos) / h and the world-frame
+//! produced the current pose, v = disp / h (disp = pos - prev_pos, kept
+//! instead of prev_pos, see `BodyState`) and the world-frame
 //! turn rot * prev_rot^* = exp(w h), which is what the next `integrate`
 //! repeats.
 //!
@@ -250,10 +251,8 @@ impl World {
     }
 
     /// Sets a body's velocities (m/s and rad/s, world frame): from here it
-    /// moves as a body loaded with them does, x + v t + g t^2 / 2 (so under
-    /// gravity `read_state` before the next step, which reports the
-    /// velocity over the last substep h, shows v - g h / 2). No effect on a
-    /// fixed body.
+    /// moves as a body loaded with them does, x + v t + g t^2 / 2, and
+    /// `read_state` before the next step shows v. No effect on a fixed body.
     pub fn set_velocity(&mut self, body: usize, linear: [f32; 3], angular: [f32; 3]) -> Result<(), Error> {
         self.input_ops(&[BodyInput::Velocity { body, linear, angular }], "")
     }

@@ -1,5 +1,6 @@
-//! Snapshots: a world's whole dynamic state (the current poses with their
-//! previous poses, the step counter, the time and the last substep's length),
+//! Snapshots: a world's whole dynamic state (the current poses with the
+//! displacements and turns from their previous poses, the step counter, the
+//! time and the last substep's length),
 //! taken and restored through the API or a small binary file.
 //!
 //! What carries over from one step to the next is exactly this: every pass
@@ -15,12 +16,12 @@
 //! data (settings, ground, grid, the bodies' shapes, masses and materials,
 //! and the joints), and restoring it into another scene is refused.
 //!
-//! # File format (version 1, little-endian)
+//! # File format (version 2, little-endian)
 //!
 //! | offset | size | field |
 //! |-------:|-----:|-------|
 //! | 0 | 8 | magic `VRLTSNAP` |
-//! | 8 | 4 | version (u32) = 1 |
+//! | 8 | 4 | version (u32) = 2 |
 //! | 12 | 4 | body count n (u32) |
 //! | 16 | 8 | step counter (u64) |
 //! | 24 | 8 | simulated time, s (f64) |
@@ -31,15 +32,23 @@
 //! | 48 + 64 n | 8 | FNV-1a 64 of all bytes before it |
 //!
 //! 56 bytes plus 64 bytes per body.
+//!
+//! Version 1 held each body's previous position (xyz, and w = 1 if a contact
+//! pushed it) where version 2 holds `disp` and `pos_low`; it is read and
+//! converted: disp = pos - prev_pos (what version 1's velocity was), no
+//! rounding remainder, and the flag as it was. Its run then continues as
+//! this build runs it, not bit for bit as the run it was taken from.
 
 use std::path::Path;
 
 use super::World;
-use crate::gpu::types::BodyState;
+use crate::gpu::types::{BodyState, HELD};
 use crate::Error;
 
 const MAGIC: &[u8; 8] = b"VRLTSNAP";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
+/// The previous-position layout, still read (see the module documentation).
+const VERSION_PREV_POS: u32 = 1;
 const HEADER: usize = 48;
 const TRAILER: usize = 8;
 const POSE: usize = std::mem::size_of::<BodyState>();
@@ -96,9 +105,7 @@ impl Snapshot {
         out.extend_from_slice(&0u32.to_le_bytes());
         out.extend_from_slice(&self.scene_hash.to_le_bytes());
         for s in &self.states {
-            for v in s.pos.iter().chain(&s.prev_pos).chain(&s.rot).chain(&s.prev_rot) {
-                out.extend_from_slice(&v.to_le_bytes());
-            }
+            out.extend_from_slice(bytemuck::bytes_of(s));
         }
         let sum = fnv1a(FNV_OFFSET, &out);
         out.extend_from_slice(&sum.to_le_bytes());
@@ -117,8 +124,10 @@ impl Snapshot {
         let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
         let f32_at = |at: usize| f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
         let version = u32_at(8);
-        if version != VERSION {
-            return Err(format!("snapshot version {version} is not supported (this build reads version {VERSION})"));
+        if version != VERSION && version != VERSION_PREV_POS {
+            return Err(format!(
+                "snapshot version {version} is not supported (this build reads versions {VERSION_PREV_POS} and {VERSION})"
+            ));
         }
         let n = u32_at(12) as usize;
         let expected = n.checked_mul(POSE).and_then(|p| p.checked_add(HEADER + TRAILER));
@@ -148,8 +157,26 @@ impl Snapshot {
         let states = (0..n)
             .map(|i| {
                 let at = HEADER + i * POSE;
-                let v4 = |k: usize| std::array::from_fn(|c| f32_at(at + 16 * k + 4 * c));
-                BodyState { pos: v4(0), prev_pos: v4(1), rot: v4(2), prev_rot: v4(3) }
+                let v4 = |k: usize| -> [f32; 4] { std::array::from_fn(|c| f32_at(at + 16 * k + 4 * c)) };
+                let pos = v4(0);
+                if version == VERSION_PREV_POS {
+                    let prev = v4(1);
+                    return BodyState {
+                        pos,
+                        disp: std::array::from_fn(|c| pos[c] - prev[c]),
+                        pos_low: if prev[3] > 0.0 { HELD } else { 0 },
+                        rot: v4(2),
+                        prev_rot: v4(3),
+                    };
+                }
+                let second = v4(1);
+                BodyState {
+                    pos,
+                    disp: [second[0], second[1], second[2]],
+                    pos_low: u32_at(at + 28),
+                    rot: v4(2),
+                    prev_rot: v4(3),
+                }
             })
             .collect();
         Ok(Snapshot { step, time, dt_prev, scene_hash, states })
