@@ -25,10 +25,8 @@ fn main() -> std::process::ExitCode {
         let kick = scene.bodies[middle].mass * 3.0;
 
         // Scripted input: the same events `verlet run --input push.json` reads.
-        let track = Track::new(vec![Event {
-            t: 1.0,
-            action: Action::Impulse { body: middle, impulse: [0.0, 0.0, kick], point: None },
-        }])?;
+        let track =
+            Track::new(vec![Event { t: 1.0, action: Action::Impulse { body: middle, impulse: [0.0, 0.0, kick], point: None } }])?;
         track.check(scene.bodies.len())?; // body indices against the scene, before anything runs
         let path = out.join("push.json");
         common::write(&path, track.to_json())?;

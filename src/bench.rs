@@ -335,10 +335,7 @@ pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|t| {
-            t.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, v)| v.trim().to_string())
+            t.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split_once(':')).map(|(_, v)| v.trim().to_string())
         })
         .unwrap_or_else(|| "unknown".into())
 }
@@ -552,8 +549,7 @@ pub mod peer {
     impl RapierWorld {
         pub fn new(scene: &Scene, sleeping: bool, iterations: Option<usize>) -> RapierWorld {
             let s = &scene.settings;
-            let mut w =
-                PhysicsWorld { gravity: Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]), ..Default::default() };
+            let mut w = PhysicsWorld { gravity: Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]), ..Default::default() };
             w.integration_parameters.dt = s.dt;
             if let Some(k) = iterations {
                 w.integration_parameters.num_solver_iterations = k.max(1);
@@ -566,8 +562,8 @@ pub mod peer {
                     .restitution_combine_rule(CoefficientCombineRule::Max)
             };
             if let Some(g) = &scene.ground {
-                let ground = ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Y))
-                    .translation(Vector::new(0.0, g.height, 0.0));
+                let ground =
+                    ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Y)).translation(Vector::new(0.0, g.height, 0.0));
                 w.insert_collider(material(ground, s.friction, s.restitution), None);
             }
             let mut handles = Vec::with_capacity(scene.bodies.len());
@@ -588,11 +584,8 @@ pub mod peer {
                     Shape::Box { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
                     Shape::Sphere { radius } => ColliderBuilder::ball(radius),
                 };
-                let collider = material(
-                    shape.mass(b.mass),
-                    b.friction.unwrap_or(s.friction),
-                    b.restitution.unwrap_or(s.restitution),
-                );
+                let collider =
+                    material(shape.mass(b.mass), b.friction.unwrap_or(s.friction), b.restitution.unwrap_or(s.restitution));
                 handles.push(w.insert(body, collider).0);
             }
             let mut anchor_body = None;
@@ -650,7 +643,11 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
         return Err(Error::Input("--reps: must be at least 1".into()));
     }
     let specs: Vec<String> = if opts.cases.is_empty() {
-        if opts.quick { QUICK_CASES.iter().map(|s| s.to_string()).collect() } else { CASES.iter().map(|c| c.0.to_string()).collect() }
+        if opts.quick {
+            QUICK_CASES.iter().map(|s| s.to_string()).collect()
+        } else {
+            CASES.iter().map(|c| c.0.to_string()).collect()
+        }
     } else {
         opts.cases.iter().flat_map(|s| s.split(',')).map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect()
     };
@@ -677,10 +674,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     let gpu_open_s = started.elapsed().as_secs_f64();
     let max = world::max_bodies(&gpu);
     let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-    progress!(
-        "bench: {} (up to {steps} steps, at most {body_steps} body-steps, x {reps} reps per case)",
-        gpu.describe()
-    );
+    progress!("bench: {} (up to {steps} steps, at most {body_steps} body-steps, x {reps} reps per case)", gpu.describe());
     let mesa_cache = std::env::var("MESA_SHADER_CACHE_DISABLE").is_ok_and(|v| v == "true" || v == "1");
 
     let settings = crate::Settings::default();
@@ -833,10 +827,9 @@ fn run_case(
     // counted before it is built: a case beyond the adapter is not made
     let bodies = scenes::body_count(&case.scene, case.count).unwrap_or(0);
     if bodies > max {
-        let why = scenes::check(&case.scene, case.count, max).err().map_or_else(
-            || format!("{bodies} bodies exceed max_bodies = {max}"),
-            |e| e.to_string(),
-        );
+        let why = scenes::check(&case.scene, case.count, max)
+            .err()
+            .map_or_else(|| format!("{bodies} bodies exceed max_bodies = {max}"), |e| e.to_string());
         if case.scene != "cubes" || max == 0 {
             progress!("warning: {}: does not fit, skipped: {why}", case.name);
             let empty = scenes::by_name(&case.scene, Some(0), SEED).unwrap_or_default();
@@ -876,7 +869,12 @@ fn run_case(
     out.first_step_ms = t.elapsed().as_secs_f64() * 1e3;
     out.startup_s = upload + out.first_step_ms * 1e-3;
     drop(world);
-    progress!("{}: {n} bodies, start-up {:.2} s (first step {:.1} ms); {steps} steps per rep", case.name, out.startup_s, out.first_step_ms);
+    progress!(
+        "{}: {n} bodies, start-up {:.2} s (first step {:.1} ms); {steps} steps per rep",
+        case.name,
+        out.startup_s,
+        out.first_step_ms
+    );
 
     // 2. repetitions from the same initial state
     let mut setups = Vec::new();
@@ -911,8 +909,7 @@ fn run_case(
         readbacks.push(t.elapsed().as_secs_f64() * 1e3);
     }
     out.readback_ms = median(&readbacks);
-    out.mean_height =
-        mean_height(bodies.iter().zip(&scene.bodies).filter(|(_, b)| !b.fixed).map(|(o, _)| o.position[1]));
+    out.mean_height = mean_height(bodies.iter().zip(&scene.bodies).filter(|(_, b)| !b.fixed).map(|(o, _)| o.position[1]));
     let report = world.contact_report()?;
     out.max_contacts = report.manifolds_max;
     out.contacts_overflowed = report.overflowed();
@@ -1055,7 +1052,10 @@ fn targets(report: &Report) -> Vec<Target> {
         Some(r) => Target {
             target: tmem.into(),
             met: Some(r.gpu_bytes_per_body <= 512.0),
-            measured: format!("{}: {:.0} B/body allocated ({} B/body by bytes_per_body)", r.case, r.gpu_bytes_per_body, report.bytes_per_body),
+            measured: format!(
+                "{}: {:.0} B/body allocated ({} B/body by bytes_per_body)",
+                r.case, r.gpu_bytes_per_body, report.bytes_per_body
+            ),
         },
         None => Target { target: tmem.into(), met: None, measured: "not run".into() },
     });
@@ -1314,12 +1314,7 @@ mod tests {
 
     #[test]
     fn exponent_of_a_power_law() {
-        let mk = |n: usize, ms: f64| CaseResult {
-            scene: "cubes".into(),
-            bodies: n,
-            median_ms_per_step: ms,
-            ..result_stub()
-        };
+        let mk = |n: usize, ms: f64| CaseResult { scene: "cubes".into(), bodies: n, median_ms_per_step: ms, ..result_stub() };
         let rs = vec![mk(10_000, 2.0), mk(100_000, 20.0), mk(1_000_000, 200.0), mk(1_000, 99.0)];
         let s = scaling(&rs).unwrap();
         assert!((s.exponent - 1.0).abs() < 1e-9, "{}", s.exponent);

@@ -286,9 +286,7 @@ fn load_track(path: &Path) -> Result<Track, Error> {
             path.display(),
             error.to_string().replace('\n', " ")
         )),
-        e @ (TrackError::Syntax { .. } | TrackError::SceneGiven(_)) => {
-            Error::Input(format!("--input {}: {e}", path.display()))
-        }
+        e @ (TrackError::Syntax { .. } | TrackError::SceneGiven(_)) => Error::Input(format!("--input {}: {e}", path.display())),
         e => e.into(),
     })
 }
@@ -587,9 +585,8 @@ impl Recorder {
             None => None,
         };
         if let Some(dir) = &args.frames {
-            std::fs::create_dir_all(dir).map_err(|e| {
-                Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display()))
-            })?;
+            std::fs::create_dir_all(dir)
+                .map_err(|e| Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display())))?;
         }
         let gif = args.gif.as_ref().map(|path| (path.clone(), Reel::new(GIF_FRAMES, GIF_BOX)));
         let sheet = args.contact_sheet.as_ref().map(|path| (path.clone(), Reel::new(SHEET_TILES, SHEET_BOX)));

@@ -274,21 +274,12 @@ impl RenderPipelines {
                     compilation_options: Default::default(),
                     buffers,
                 },
-                primitive: wgpu::PrimitiveState {
-                    topology,
-                    front_face: wgpu::FrontFace::Ccw,
-                    cull_mode,
-                    ..Default::default()
-                },
+                primitive: wgpu::PrimitiveState { topology, front_face: wgpu::FrontFace::Ccw, cull_mode, ..Default::default() },
                 depth_stencil: Some(wgpu::DepthStencilState {
                     format: DEPTH_FORMAT,
                     depth_write_enabled: Some(!overlay),
                     // reversed depth: nearer is greater; an overlay ignores depth
-                    depth_compare: Some(if overlay {
-                        wgpu::CompareFunction::Always
-                    } else {
-                        wgpu::CompareFunction::Greater
-                    }),
+                    depth_compare: Some(if overlay { wgpu::CompareFunction::Always } else { wgpu::CompareFunction::Greater }),
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),
@@ -375,13 +366,7 @@ impl Renderer {
     /// As [`Renderer::new`], with options. Refuses a size of 0 or beyond the
     /// device's `max_texture_dimension_2d`, naming the `--width`/`--height`
     /// flag, before allocating anything.
-    pub fn with_options(
-        gpu: &Gpu,
-        scene: &Scene,
-        width: u32,
-        height: u32,
-        options: RenderOptions,
-    ) -> Result<Renderer, Error> {
+    pub fn with_options(gpu: &Gpu, scene: &Scene, width: u32, height: u32, options: RenderOptions) -> Result<Renderer, Error> {
         scene.validate()?;
         let max = gpu.limits.max_texture_dimension_2d;
         for (flag, v) in [("--width", width), ("--height", height)] {
@@ -400,8 +385,7 @@ impl Renderer {
                 gpu.limits.max_buffer_size
             )));
         }
-        let vertex_storage =
-            gpu.adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE);
+        let vertex_storage = gpu.adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE);
         if !vertex_storage || gpu.limits.max_storage_buffers_per_shader_stage < 3 {
             return Err(Error::Capacity(
                 "rendering reads 3 storage buffers in the vertex shader, which this adapter does not allow".into(),
@@ -432,12 +416,7 @@ impl Renderer {
         let joints: Vec<JointLine> = scene
             .joints
             .iter()
-            .map(|j| JointLine {
-                anchor_a: j.anchors[0],
-                body_a: j.bodies[0],
-                anchor_b: j.anchors[1],
-                body_b: j.bodies[1],
-            })
+            .map(|j| JointLine { anchor_a: j.anchors[0], body_a: j.bodies[0], anchor_b: j.anchors[1], body_b: j.bodies[1] })
             .collect();
 
         let (camera, framing) = choose_camera(scene, width as f32 / height as f32);
@@ -613,8 +592,7 @@ impl Renderer {
         if world.gpu().device != self.device {
             return Err(Error::Input("render: the world lives on another device than the renderer".into()));
         }
-        let state =
-            if self.body_count == 0 { self.data.empty_state.clone() } else { world.current_state_buffer().clone() };
+        let state = if self.body_count == 0 { self.data.empty_state.clone() } else { world.current_state_buffer().clone() };
         let bind_group = self.bind_group(&state);
 
         let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("render") });
@@ -647,12 +625,7 @@ impl Renderer {
                     depth_slice: None,
                     resolve_target: Some(&self.data.resolved_view),
                     ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: bg[0] as f64,
-                            g: bg[1] as f64,
-                            b: bg[2] as f64,
-                            a: 1.0,
-                        }),
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 1.0 }),
                         // only the resolved image is needed
                         store: wgpu::StoreOp::Discard,
                     },
@@ -721,8 +694,7 @@ impl Renderer {
         // unmapped whatever happened, so the next frame can copy into it
         self.data.readback.unmap();
         let pixels = pixels.map_err(|e| gpu_err(e.to_string()))?;
-        RgbaImage::from_raw(self.width, self.height, pixels)
-            .ok_or_else(|| gpu_err("render: readback has the wrong size".into()))
+        RgbaImage::from_raw(self.width, self.height, pixels).ok_or_else(|| gpu_err("render: readback has the wrong size".into()))
     }
 
     /// One instanced draw per mesh: the boxes' slots, then the spheres'.
@@ -807,12 +779,7 @@ fn choose_camera(scene: &Scene, aspect: f32) -> (CameraView, Framing) {
     let camera = match &scene.camera {
         Some(c) => {
             let forward = Vec3::from_array(c.target) - Vec3::from_array(c.position);
-            CameraView {
-                position: c.position,
-                target: c.target,
-                up: up_for(forward).to_array(),
-                fov_y: c.fov_y,
-            }
+            CameraView { position: c.position, target: c.target, up: up_for(forward).to_array(), fov_y: c.fov_y }
         }
         None => {
             let fov_y = DEFAULT_FOV_Y;

@@ -182,9 +182,7 @@ impl Shape {
 
     fn volume_f64(&self) -> f64 {
         match *self {
-            Shape::Box {
-                half_extents: [a, b, c],
-            } => 8.0 * a as f64 * b as f64 * c as f64,
+            Shape::Box { half_extents: [a, b, c] } => 8.0 * a as f64 * b as f64 * c as f64,
             Shape::Sphere { radius } => {
                 let r = radius as f64;
                 4.0 / 3.0 * std::f64::consts::PI * r * r * r
@@ -196,9 +194,7 @@ impl Shape {
     /// the shape.
     pub fn bounding_radius(&self) -> f32 {
         match *self {
-            Shape::Box {
-                half_extents: [a, b, c],
-            } => {
+            Shape::Box { half_extents: [a, b, c] } => {
                 let (a, b, c) = (a as f64, b as f64, c as f64);
                 (a * a + b * b + c * c).sqrt() as f32
             }
@@ -211,15 +207,9 @@ impl Shape {
     fn inertia_f64(&self, mass: f32) -> [f64; 3] {
         let m = mass as f64;
         match *self {
-            Shape::Box {
-                half_extents: [a, b, c],
-            } => {
+            Shape::Box { half_extents: [a, b, c] } => {
                 let (a2, b2, c2) = ((a as f64).powi(2), (b as f64).powi(2), (c as f64).powi(2));
-                [
-                    m / 3.0 * (b2 + c2),
-                    m / 3.0 * (a2 + c2),
-                    m / 3.0 * (a2 + b2),
-                ]
+                [m / 3.0 * (b2 + c2), m / 3.0 * (a2 + c2), m / 3.0 * (a2 + b2)]
             }
             Shape::Sphere { radius } => {
                 let i = 0.4 * m * (radius as f64).powi(2);
@@ -293,11 +283,7 @@ impl Body {
             return [0.0; 3];
         }
         let i = self.shape.inertia_f64(self.mass);
-        [
-            (1.0 / i[0]) as f32,
-            (1.0 / i[1]) as f32,
-            (1.0 / i[2]) as f32,
-        ]
+        [(1.0 / i[0]) as f32, (1.0 / i[1]) as f32, (1.0 / i[2]) as f32]
     }
 
     /// Radius in metres of the smallest sphere around the centre of mass
@@ -377,10 +363,7 @@ impl SceneError {
     }
 
     fn invalid(field: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid {
-            field: field.into(),
-            message: message.into(),
-        }
+        SceneError::Invalid { field: field.into(), message: message.into() }
     }
 
     fn missing(field: impl Into<String>) -> SceneError {
@@ -402,9 +385,7 @@ impl Scene {
         let Obj(raw): Obj<RawScene> = serde_path_to_error::deserialize(&mut deserializer)
             .map_err(|error| json_error(path_string(error.path()), error.into_inner()))?;
         // Refuse anything after the scene object, as serde_json::from_str does.
-        deserializer
-            .end()
-            .map_err(|error| json_error(None, error))?;
+        deserializer.end().map_err(|error| json_error(None, error))?;
         let scene = raw.into_scene()?;
         scene.validate()?;
         Ok(scene)
@@ -412,10 +393,7 @@ impl Scene {
 
     /// Reads, parses and validates a scene file.
     pub fn from_path(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
-            path: path.to_path_buf(),
-            error,
-        })?;
+        let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io { path: path.to_path_buf(), error })?;
         Scene::from_json_str(&text)
     }
 }
@@ -467,10 +445,9 @@ pub(crate) fn classify_json_error(field: Option<String>, inner: serde_json::Erro
     match (inner.classify(), field) {
         // A number too large for any float (like 1e999) is valid JSON
         // grammar but not a usable value: blame the field it is in.
-        (Category::Syntax, Some(field)) if number_out_of_range => JsonFault::Invalid {
-            field,
-            message: format!("number out of range, must be finite (line {line}, column {column})"),
-        },
+        (Category::Syntax, Some(field)) if number_out_of_range => {
+            JsonFault::Invalid { field, message: format!("number out of range, must be finite (line {line}, column {column})") }
+        }
         // Unknown field, wrong type, out-of-range integer, ...
         (Category::Data, field) => JsonFault::Invalid {
             field: field.unwrap_or_else(|| top.to_string()),
@@ -556,9 +533,7 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for Obj<T> {
             }
         }
 
-        deserializer
-            .deserialize_map(ObjectVisitor(std::marker::PhantomData))
-            .map(Obj)
+        deserializer.deserialize_map(ObjectVisitor(std::marker::PhantomData)).map(Obj)
     }
 }
 
@@ -641,11 +616,7 @@ impl RawScene {
             None => Settings::default(),
         };
         let ground = match self.ground {
-            Some(Obj(raw)) => Some(Ground {
-                height: raw
-                    .height
-                    .ok_or_else(|| SceneError::missing("ground.height"))?,
-            }),
+            Some(Obj(raw)) => Some(Ground { height: raw.height.ok_or_else(|| SceneError::missing("ground.height"))? }),
             None => None,
         };
         let bodies = self
@@ -666,13 +637,7 @@ impl RawScene {
             Some(Obj(raw)) => Some(raw.into_camera()?),
             None => None,
         };
-        Ok(Scene {
-            settings,
-            ground,
-            bodies,
-            joints,
-            camera,
-        })
+        Ok(Scene { settings, ground, bodies, joints, camera })
     }
 }
 
@@ -700,18 +665,10 @@ impl RawSettings {
 impl RawBody {
     fn into_body(self, path: &str) -> Result<Body, SceneError> {
         let shape_path = format!("{path}.shape");
-        let shape = self
-            .shape
-            .ok_or_else(|| SceneError::missing(&shape_path))?
-            .0
-            .into_shape(&shape_path)?;
+        let shape = self.shape.ok_or_else(|| SceneError::missing(&shape_path))?.0.into_shape(&shape_path)?;
 
         let position_path = format!("{path}.position");
-        let position = exact(
-            self.position
-                .ok_or_else(|| SceneError::missing(&position_path))?,
-            &position_path,
-        )?;
+        let position = exact(self.position.ok_or_else(|| SceneError::missing(&position_path))?, &position_path)?;
 
         let orientation = match self.orientation {
             Some(v) => {
@@ -727,11 +684,7 @@ impl RawBody {
             (Some(density), Some(mass)) => {
                 return Err(SceneError::invalid(
                     format!("{path}.mass"),
-                    format!(
-                        "give either density or mass, not both (got mass {} and density {})",
-                        show(mass),
-                        show(density)
-                    ),
+                    format!("give either density or mass, not both (got mass {} and density {})", show(mass), show(density)),
                 ))
             }
             (None, Some(mass)) => mass,
@@ -748,14 +701,8 @@ impl RawBody {
             shape,
             position,
             orientation,
-            linear_velocity: optional_vec3(
-                self.linear_velocity,
-                &format!("{path}.linear_velocity"),
-            )?,
-            angular_velocity: optional_vec3(
-                self.angular_velocity,
-                &format!("{path}.angular_velocity"),
-            )?,
+            linear_velocity: optional_vec3(self.linear_velocity, &format!("{path}.linear_velocity"))?,
+            angular_velocity: optional_vec3(self.angular_velocity, &format!("{path}.angular_velocity"))?,
             mass,
             fixed: self.fixed.unwrap_or(false),
             restitution: self.restitution,
@@ -773,18 +720,11 @@ impl RawShape {
                 if let Some(radius) = self.radius {
                     return Err(SceneError::invalid(
                         format!("{path}.radius"),
-                        format!(
-                            "is not used by a box (got {}); a box takes half_extents",
-                            show(radius)
-                        ),
+                        format!("is not used by a box (got {}); a box takes half_extents", show(radius)),
                     ));
                 }
                 let he_path = format!("{path}.half_extents");
-                let half_extents = exact(
-                    self.half_extents
-                        .ok_or_else(|| SceneError::missing(&he_path))?,
-                    &he_path,
-                )?;
+                let half_extents = exact(self.half_extents.ok_or_else(|| SceneError::missing(&he_path))?, &he_path)?;
                 Ok(Shape::Box { half_extents })
             }
             "sphere" => {
@@ -794,15 +734,10 @@ impl RawShape {
                         "is not used by a sphere; a sphere takes radius",
                     ));
                 }
-                let radius = self
-                    .radius
-                    .ok_or_else(|| SceneError::missing(format!("{path}.radius")))?;
+                let radius = self.radius.ok_or_else(|| SceneError::missing(format!("{path}.radius")))?;
                 Ok(Shape::Sphere { radius })
             }
-            other => Err(SceneError::invalid(
-                type_path,
-                format!("unknown shape type {other:?}, expected \"box\" or \"sphere\""),
-            )),
+            other => Err(SceneError::invalid(type_path, format!("unknown shape type {other:?}, expected \"box\" or \"sphere\""))),
         }
     }
 }
@@ -812,59 +747,31 @@ impl RawJoint {
         let type_path = format!("{path}.type");
         let kind = self.kind.ok_or_else(|| SceneError::missing(&type_path))?;
         if kind != "ball" {
-            return Err(SceneError::invalid(
-                type_path,
-                format!("unknown joint type {kind:?}, expected \"ball\""),
-            ));
+            return Err(SceneError::invalid(type_path, format!("unknown joint type {kind:?}, expected \"ball\"")));
         }
 
         let bodies_path = format!("{path}.bodies");
-        let bodies = exact(
-            self.bodies
-                .ok_or_else(|| SceneError::missing(&bodies_path))?,
-            &bodies_path,
-        )?;
+        let bodies = exact(self.bodies.ok_or_else(|| SceneError::missing(&bodies_path))?, &bodies_path)?;
 
         let anchors_path = format!("{path}.anchors");
-        let [a, b]: [Vec<f32>; 2] = exact(
-            self.anchors
-                .ok_or_else(|| SceneError::missing(&anchors_path))?,
-            &anchors_path,
-        )?;
-        let anchors = [
-            exact(a, &format!("{anchors_path}[0]"))?,
-            exact(b, &format!("{anchors_path}[1]"))?,
-        ];
+        let [a, b]: [Vec<f32>; 2] = exact(self.anchors.ok_or_else(|| SceneError::missing(&anchors_path))?, &anchors_path)?;
+        let anchors = [exact(a, &format!("{anchors_path}[0]"))?, exact(b, &format!("{anchors_path}[1]"))?];
         Ok(Joint { bodies, anchors })
     }
 }
 
 impl RawCamera {
     fn into_camera(self) -> Result<Camera, SceneError> {
-        let position = exact(
-            self.position
-                .ok_or_else(|| SceneError::missing("camera.position"))?,
-            "camera.position",
-        )?;
-        let target = exact(
-            self.target
-                .ok_or_else(|| SceneError::missing("camera.target"))?,
-            "camera.target",
-        )?;
-        Ok(Camera {
-            position,
-            target,
-            fov_y: self.fov_y.unwrap_or(DEFAULT_FOV_Y),
-        })
+        let position = exact(self.position.ok_or_else(|| SceneError::missing("camera.position"))?, "camera.position")?;
+        let target = exact(self.target.ok_or_else(|| SceneError::missing("camera.target"))?, "camera.target")?;
+        Ok(Camera { position, target, fov_y: self.fov_y.unwrap_or(DEFAULT_FOV_Y) })
     }
 }
 
 /// Turns a list into a fixed-size array, refusing any other length.
 fn exact<T, const N: usize>(values: Vec<T>, path: &str) -> Result<[T; N], SceneError> {
     let len = values.len();
-    values.try_into().map_err(|_| {
-        SceneError::invalid(path, format!("must have exactly {N} elements, got {len}"))
-    })
+    values.try_into().map_err(|_| SceneError::invalid(path, format!("must have exactly {N} elements, got {len}")))
 }
 
 fn optional_vec3(values: Option<Vec<f32>>, path: &str) -> Result<[f32; 3], SceneError> {
@@ -907,10 +814,7 @@ fn normalise(q: [f32; 4]) -> [f32; 4] {
 
 /// Length of a quaternion, in f64 so that large components do not overflow.
 fn quaternion_norm(q: [f32; 4]) -> f64 {
-    q.iter()
-        .map(|&c| (c as f64) * (c as f64))
-        .sum::<f64>()
-        .sqrt()
+    q.iter().map(|&c| (c as f64) * (c as f64)).sum::<f64>().sqrt()
 }
 
 // ---------------------------------------------------------------------------
@@ -946,28 +850,19 @@ fn validate_settings(s: &Settings) -> Result<(), SceneError> {
     if !(1..=MAX_ITERATIONS).contains(&s.iterations) {
         return Err(SceneError::invalid(
             "settings.iterations",
-            format!(
-                "must be between 1 and {MAX_ITERATIONS}, got {}",
-                s.iterations
-            ),
+            format!("must be between 1 and {MAX_ITERATIONS}, got {}", s.iterations),
         ));
     }
     check_finite(s.relaxation, "settings.relaxation")?;
     if !(s.relaxation > 0.0 && s.relaxation <= 1.0) {
-        return Err(SceneError::invalid(
-            "settings.relaxation",
-            format!("must be in (0, 1], got {}", show(s.relaxation)),
-        ));
+        return Err(SceneError::invalid("settings.relaxation", format!("must be in (0, 1], got {}", show(s.relaxation))));
     }
     check_damping(s.linear_damping, "settings.linear_damping")?;
     check_damping(s.angular_damping, "settings.angular_damping")?;
     check_restitution(s.restitution, "settings.restitution")?;
     check_friction(s.friction, "settings.friction")?;
     if !(1..=MAX_SUBSTEPS).contains(&s.substeps) {
-        return Err(SceneError::invalid(
-            "settings.substeps",
-            format!("must be between 1 and {MAX_SUBSTEPS}, got {}", s.substeps),
-        ));
+        return Err(SceneError::invalid("settings.substeps", format!("must be between 1 and {MAX_SUBSTEPS}, got {}", s.substeps)));
     }
     Ok(())
 }
@@ -1042,9 +937,7 @@ fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Result<(), Sc
             };
             return Err(SceneError::invalid(
                 format!("{path}.bodies[{k}]"),
-                format!(
-                    "names body {index}, but the scene has {body_count} bodies (valid: {valid})"
-                ),
+                format!("names body {index}, but the scene has {body_count} bodies (valid: {valid})"),
             ));
         }
     }
@@ -1069,19 +962,13 @@ fn validate_camera(camera: &Camera) -> Result<(), SceneError> {
     if camera.position == camera.target {
         return Err(SceneError::invalid(
             "camera.target",
-            format!(
-                "must differ from camera.position, both are {:?}",
-                camera.position
-            ),
+            format!("must differ from camera.position, both are {:?}", camera.position),
         ));
     }
     let fov = camera.fov_y;
     check_finite(fov, "camera.fov_y")?;
     if !(fov > 0.0 && fov < std::f32::consts::PI) {
-        return Err(SceneError::invalid(
-            "camera.fov_y",
-            format!("must be in (0, pi) radians, got {}", show(fov)),
-        ));
+        return Err(SceneError::invalid("camera.fov_y", format!("must be in (0, pi) radians, got {}", show(fov))));
     }
     Ok(())
 }
@@ -1112,7 +999,7 @@ fn check_shape(shape: &Shape, path: &str) -> Result<(), SceneError> {
     let r = shape.bounding_radius();
     if r < MIN_BOUNDING_RADIUS {
         return Err(SceneError::invalid(
-            &format!("{path}.{field}"),
+            format!("{path}.{field}"),
             format!(
                 "the body is too small: its bounding radius is {} m, the solver handles {} m and up \
                  (smaller bodies sink into what they land on and spin up from rounding)",
@@ -1130,10 +1017,7 @@ fn check_orientation(q: [f32; 4], path: &str) -> Result<(), SceneError> {
     if norm <= MIN_ORIENTATION_NORM {
         return Err(SceneError::invalid(
             path,
-            format!(
-                "must be a non-zero quaternion [x, y, z, w], got {q:?} (length {})",
-                show(norm as f32)
-            ),
+            format!("must be a non-zero quaternion [x, y, z, w], got {q:?} (length {})", show(norm as f32)),
         ));
     }
     Ok(())
@@ -1153,10 +1037,7 @@ fn check_finite(x: f32, path: &str) -> Result<(), SceneError> {
     if x.is_finite() {
         Ok(())
     } else {
-        Err(SceneError::invalid(
-            path,
-            format!("must be a finite number, got {}", show(x)),
-        ))
+        Err(SceneError::invalid(path, format!("must be a finite number, got {}", show(x))))
     }
 }
 
@@ -1172,10 +1053,7 @@ fn check_positive(x: f32, path: &str) -> Result<(), SceneError> {
     if x > 0.0 {
         Ok(())
     } else {
-        Err(SceneError::invalid(
-            path,
-            format!("must be positive, got {}", show(x)),
-        ))
+        Err(SceneError::invalid(path, format!("must be positive, got {}", show(x))))
     }
 }
 
@@ -1184,10 +1062,7 @@ fn check_damping(x: f32, path: &str) -> Result<(), SceneError> {
     if (0.0..1.0).contains(&x) {
         Ok(())
     } else {
-        Err(SceneError::invalid(
-            path,
-            format!("must be in [0, 1), got {}", show(x)),
-        ))
+        Err(SceneError::invalid(path, format!("must be in [0, 1), got {}", show(x))))
     }
 }
 
@@ -1196,10 +1071,7 @@ fn check_restitution(x: f32, path: &str) -> Result<(), SceneError> {
     if (0.0..=1.0).contains(&x) {
         Ok(())
     } else {
-        Err(SceneError::invalid(
-            path,
-            format!("must be in [0, 1], got {}", show(x)),
-        ))
+        Err(SceneError::invalid(path, format!("must be in [0, 1], got {}", show(x))))
     }
 }
 
@@ -1208,10 +1080,7 @@ fn check_friction(x: f32, path: &str) -> Result<(), SceneError> {
     if x >= 0.0 {
         Ok(())
     } else {
-        Err(SceneError::invalid(
-            path,
-            format!("must be >= 0, got {}", show(x)),
-        ))
+        Err(SceneError::invalid(path, format!("must be >= 0, got {}", show(x))))
     }
 }
 
@@ -1232,10 +1101,7 @@ impl Scene {
     pub fn to_json(&self) -> String {
         let mut top: Vec<(&str, String)> = vec![("settings", settings_json(&self.settings))];
         if let Some(ground) = &self.ground {
-            top.push((
-                "ground",
-                format!("{{ \"height\": {} }}", num(ground.height)),
-            ));
+            top.push(("ground", format!("{{ \"height\": {} }}", num(ground.height))));
         }
         let bodies: Vec<String> = self.bodies.iter().map(body_json).collect();
         top.push(("bodies", list_json(&bodies)));
@@ -1275,10 +1141,7 @@ fn settings_json(s: &Settings) -> String {
 fn body_json(body: &Body) -> String {
     let shape = match body.shape {
         Shape::Box { half_extents } => {
-            format!(
-                "{{ \"type\": \"box\", \"half_extents\": {} }}",
-                nums(&half_extents)
-            )
+            format!("{{ \"type\": \"box\", \"half_extents\": {} }}", nums(&half_extents))
         }
         Shape::Sphere { radius } => {
             format!("{{ \"type\": \"sphere\", \"radius\": {} }}", num(radius))
@@ -1451,11 +1314,7 @@ mod tests {
         assert!(close(body.inverse_mass(), 1.0 / 3000.0));
         // I = m/3 (b² + c², a² + c², a² + b²) with half extents a, b, c.
         let m = 3000.0f32;
-        let expected = [
-            m / 3.0 * (1.0 + 2.25),
-            m / 3.0 * (0.25 + 2.25),
-            m / 3.0 * (0.25 + 1.0),
-        ];
+        let expected = [m / 3.0 * (1.0 + 2.25), m / 3.0 * (0.25 + 2.25), m / 3.0 * (0.25 + 1.0)];
         let inv = body.inverse_inertia();
         for k in 0..3 {
             assert!(close(inv[k], 1.0 / expected[k]), "axis {k}: {inv:?}");
@@ -1485,20 +1344,10 @@ mod tests {
 
     #[test]
     fn body_new_uses_default_density() {
-        let body = Body::new(
-            Shape::Box {
-                half_extents: [0.5; 3],
-            },
-            [0.0, 1.0, 0.0],
-        );
+        let body = Body::new(Shape::Box { half_extents: [0.5; 3] }, [0.0, 1.0, 0.0]);
         assert_eq!(body.mass, 1000.0);
         assert_eq!(body.orientation, IDENTITY_ORIENTATION);
-        assert!(Scene {
-            bodies: vec![body],
-            ..Scene::default()
-        }
-        .validate()
-        .is_ok());
+        assert!(Scene { bodies: vec![body], ..Scene::default() }.validate().is_ok());
     }
 
     #[test]
@@ -1507,10 +1356,7 @@ mod tests {
                        "position": [0, 0, 0], "orientation": [0, 0, 2, 2]}]}"#;
         let q = Scene::from_json_str(text).unwrap().bodies[0].orientation;
         let h = std::f32::consts::FRAC_1_SQRT_2;
-        assert!(
-            close(q[0], 0.0) && close(q[1], 0.0) && close(q[2], h) && close(q[3], h),
-            "{q:?}"
-        );
+        assert!(close(q[0], 0.0) && close(q[1], 0.0) && close(q[2], h) && close(q[3], h), "{q:?}");
 
         // The example's [0, 0, 0.13, 0.99] is not quite unit length.
         let q = Scene::from_json_str(INTERFACE_EXAMPLE).unwrap().bodies[2].orientation;
@@ -1518,12 +1364,7 @@ mod tests {
         assert!(close(q[2] / q[3], 0.13 / 0.99));
 
         // Normalising twice changes nothing, bit for bit.
-        for raw in [
-            [0.0, 0.0, 0.13, 0.99],
-            [1.0, 2.0, 3.0, 4.0],
-            [1e-3, 0.0, 0.0, 0.0],
-            [3e38, 3e38, 0.0, 0.0],
-        ] {
+        for raw in [[0.0, 0.0, 0.13, 0.99], [1.0, 2.0, 3.0, 4.0], [1e-3, 0.0, 0.0, 0.0], [3e38, 3e38, 0.0, 0.0]] {
             let once = normalise(raw);
             assert_eq!(normalise(once), once, "{raw:?}");
             assert!((quaternion_norm(once) - 1.0).abs() < 1e-6, "{raw:?}");
@@ -1565,16 +1406,34 @@ mod tests {
             (r#"{"ground": {}}"#.to_string(), "ground.height: is required but missing"),
             (r#"{"ground": {"height": 1, "normal": [0, 1, 0]}}"#.to_string(), "ground.normal: unknown field"),
             (r#"{"camera": {"position": [1, 1, 1], "target": [1, 1, 1]}}"#.to_string(), "camera.target: must differ"),
-            (r#"{"camera": {"position": [1, 1, 1], "target": [0, 0, 0], "fov_y": 3.2}}"#.to_string(), "camera.fov_y: must be in (0, pi)"),
+            (
+                r#"{"camera": {"position": [1, 1, 1], "target": [0, 0, 0], "fov_y": 3.2}}"#.to_string(),
+                "camera.fov_y: must be in (0, pi)",
+            ),
             (r#"{"camera": {"target": [0, 0, 0]}}"#.to_string(), "camera.position: is required"),
-            (r#"{"joints": [{"type": "hinge", "bodies": [0, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(), "joints[0].type: unknown joint type \"hinge\""),
-            (r#"{"joints": [{"type": "ball", "bodies": [-1, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(), "joints[0].bodies: both sides are the world"),
-            (r#"{"joints": [{"type": "ball", "bodies": [0, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(), "joints[0].bodies[0]: names body 0, but the scene has 0 bodies"),
-            (r#"{"joints": [{"type": "ball", "bodies": [0, -1], "anchors": [[0,0,0]]}]}"#.to_string(), "joints[0].anchors: must have exactly 2 elements, got 1"),
+            (
+                r#"{"joints": [{"type": "hinge", "bodies": [0, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(),
+                "joints[0].type: unknown joint type \"hinge\"",
+            ),
+            (
+                r#"{"joints": [{"type": "ball", "bodies": [-1, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(),
+                "joints[0].bodies: both sides are the world",
+            ),
+            (
+                r#"{"joints": [{"type": "ball", "bodies": [0, -1], "anchors": [[0,0,0],[0,0,0]]}]}"#.to_string(),
+                "joints[0].bodies[0]: names body 0, but the scene has 0 bodies",
+            ),
+            (
+                r#"{"joints": [{"type": "ball", "bodies": [0, -1], "anchors": [[0,0,0]]}]}"#.to_string(),
+                "joints[0].anchors: must have exactly 2 elements, got 1",
+            ),
             (r#"[]"#.to_string(), "scene: invalid type: sequence, expected a JSON object"),
             (r#"{"settings": [0.1]}"#.to_string(), "settings: invalid type: sequence, expected a JSON object"),
             (body(r#", "shape": 3"#), "bodies[1]: duplicate field `shape`"),
-            (r#"{"bodies": [{"shape": [], "position": [0, 0, 0]}]}"#.to_string(), "bodies[0].shape: invalid type: sequence, expected a JSON object"),
+            (
+                r#"{"bodies": [{"shape": [], "position": [0, 0, 0]}]}"#.to_string(),
+                "bodies[0].shape: invalid type: sequence, expected a JSON object",
+            ),
             (r#"{"bodies": {}}"#.to_string(), "bodies: invalid type: map, expected a sequence"),
             (r#"{} {}"#.to_string(), "line 1, column 4: malformed JSON: trailing characters"),
             (r#""#.to_string(), "line 1, column 0: malformed JSON: EOF while parsing a value"),
@@ -1582,10 +1441,7 @@ mod tests {
         ];
         for (text, expected) in cases {
             let message = error_of(&text);
-            assert!(
-                message.starts_with(expected),
-                "for {text}\n  got      {message}\n  expected {expected}…"
-            );
+            assert!(message.starts_with(expected), "for {text}\n  got      {message}\n  expected {expected}…");
             assert!(!message.contains('\n'), "{message}");
         }
     }
@@ -1595,21 +1451,15 @@ mod tests {
         let message = error_of(r#"{"settings": {"d\nt": 1}}"#);
         assert!(message.starts_with("settings"), "{message}");
         assert!(!message.contains('\n'), "{message}");
-        let message =
-            error_of(r#"{"bodies": [{"shape": {"type": "co\nne"}, "position": [0,0,0]}]}"#);
-        assert!(
-            message.starts_with("bodies[0].shape.type: unknown shape type"),
-            "{message}"
-        );
+        let message = error_of(r#"{"bodies": [{"shape": {"type": "co\nne"}, "position": [0,0,0]}]}"#);
+        assert!(message.starts_with("bodies[0].shape.type: unknown shape type"), "{message}");
         assert!(!message.contains('\n'), "{message}");
     }
 
     #[test]
     fn validate_checks_scenes_built_in_rust() {
         let mut scene = Scene::default();
-        scene
-            .bodies
-            .push(Body::new(Shape::Sphere { radius: 1.0 }, [0.0; 3]));
+        scene.bodies.push(Body::new(Shape::Sphere { radius: 1.0 }, [0.0; 3]));
         assert!(scene.validate().is_ok());
         scene.bodies[0].orientation = [0.0, f32::NAN, 0.0, 1.0];
         let e = scene.validate().unwrap_err();
@@ -1619,18 +1469,10 @@ mod tests {
         // Extreme but individually valid values that overflow the inverse
         // inertia (a body that small is refused for its size first).
         let mut scene = Scene::default();
-        let mut body = Body::new(
-            Shape::Box {
-                half_extents: [0.5; 3],
-            },
-            [0.0; 3],
-        );
+        let mut body = Body::new(Shape::Box { half_extents: [0.5; 3] }, [0.0; 3]);
         body.mass = 1e-44;
         scene.bodies.push(body);
-        assert_eq!(
-            scene.validate().unwrap_err().field(),
-            Some("bodies[0].mass")
-        );
+        assert_eq!(scene.validate().unwrap_err().field(), Some("bodies[0].mass"));
     }
 
     #[test]
@@ -1658,30 +1500,14 @@ mod tests {
         for end in 0..text.len() {
             let _ = Scene::from_json_str(&text[..end]);
         }
-        let replacements = [
-            "-1",
-            "0",
-            "1e999",
-            "null",
-            "[]",
-            "{}",
-            "\"x\"",
-            "true",
-            "-2147483649",
-            "1e-45",
-        ];
+        let replacements = ["-1", "0", "1e999", "null", "[]", "{}", "\"x\"", "true", "-2147483649", "1e-45"];
         let number_starts: Vec<usize> = text
             .char_indices()
-            .filter(|&(i, c)| {
-                c.is_ascii_digit()
-                    && !text[..i].ends_with(|p: char| p.is_ascii_digit() || p == '.' || p == '-')
-            })
+            .filter(|&(i, c)| c.is_ascii_digit() && !text[..i].ends_with(|p: char| p.is_ascii_digit() || p == '.' || p == '-'))
             .map(|(i, _)| i)
             .collect();
         for &start in &number_starts {
-            let end = text[start..]
-                .find(|c: char| !(c.is_ascii_digit() || c == '.'))
-                .map_or(text.len(), |n| start + n);
+            let end = text[start..].find(|c: char| !(c.is_ascii_digit() || c == '.')).map_or(text.len(), |n| start + n);
             for r in replacements {
                 let mangled = format!("{}{}{}", &text[..start], r, &text[end..]);
                 if let Err(e) = Scene::from_json_str(&mangled) {

@@ -65,13 +65,37 @@ pub struct Event {
 /// What an [`Event`] does.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Action {
-    Impulse { body: usize, impulse: [f32; 3], point: Option<[f32; 3]> },
-    Explode { centre: [f32; 3], strength: f32, radius: f32, falloff: f32 },
-    SetPose { body: usize, position: [f32; 3], orientation: [f32; 4] },
-    SetVelocity { body: usize, linear: [f32; 3], angular: [f32; 3] },
-    Fixed { body: usize, fixed: bool, mass: Option<f32> },
+    Impulse {
+        body: usize,
+        impulse: [f32; 3],
+        point: Option<[f32; 3]>,
+    },
+    Explode {
+        centre: [f32; 3],
+        strength: f32,
+        radius: f32,
+        falloff: f32,
+    },
+    SetPose {
+        body: usize,
+        position: [f32; 3],
+        orientation: [f32; 4],
+    },
+    SetVelocity {
+        body: usize,
+        linear: [f32; 3],
+        angular: [f32; 3],
+    },
+    Fixed {
+        body: usize,
+        fixed: bool,
+        mass: Option<f32>,
+    },
     /// `wind` blows before every step starting within `[t, t + duration)`.
-    Wind { wind: Wind, duration: f32 },
+    Wind {
+        wind: Wind,
+        duration: f32,
+    },
 }
 
 impl Action {
@@ -178,12 +202,11 @@ impl Track {
             return Err(TrackError::Syntax { line, column, message });
         }
         let mut deserializer = serde_json::Deserializer::from_str(text);
-        let Obj(raw): Obj<RawTrack> = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
-            match scene_key(text) {
+        let Obj(raw): Obj<RawTrack> =
+            serde_path_to_error::deserialize(&mut deserializer).map_err(|error| match scene_key(text) {
                 Some(key) => TrackError::SceneGiven(key),
                 None => json_error(path_string(error.path()), error.into_inner()),
-            }
-        })?;
+            })?;
         deserializer.end().map_err(|error| json_error(None, error))?;
         let raw_events = raw.events.ok_or_else(|| TrackError::invalid("events", "is required but missing"))?;
         let mut events = Vec::with_capacity(raw_events.len());

@@ -570,10 +570,7 @@ impl World {
     fn encode_and_submit(&mut self, dts: &[f32], substeps: usize) {
         let slot = self.write_params(dts, substeps);
 
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("step") });
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("step") });
         let plan = self.step_plan();
         for first in (0..slot).step_by(substeps) {
             for &(stage, sub) in &plan {
@@ -615,10 +612,8 @@ impl World {
             // the pair scan wrote the dispatch's size into status[8..11]
             encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12);
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(stage.name()),
-            timestamp_writes: timestamps,
-        });
+        let mut pass =
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(stage.name()), timestamp_writes: timestamps });
         pass.set_pipeline(self.pipelines.pipeline(stage));
         let groups = self.data.bind_groups.as_ref().expect("made with the buffers");
         pass.set_bind_group(0, &groups[self.current], &offset);
@@ -914,11 +909,7 @@ pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
         let s = &states[body as usize];
         dvec(s.pos) + dquat(s.rot).normalize() * l
     };
-    scene
-        .joints
-        .iter()
-        .map(|j| (anchor(j.bodies[0], j.anchors[0]) - anchor(j.bodies[1], j.anchors[1])).length() as f32)
-        .collect()
+    scene.joints.iter().map(|j| (anchor(j.bodies[0], j.anchors[0]) - anchor(j.bodies[1], j.anchors[1])).length() as f32).collect()
 }
 
 /// Every body's GPU record, the bodies kept out of the grid (marked LARGE in
@@ -943,12 +934,7 @@ pub fn body_props(b: &Body, settings: &Settings) -> BodyProps {
     BodyProps {
         half_extents: [half[0], half[1], half[2], b.bounding_radius()],
         inv_inertia: [ii[0], ii[1], ii[2], b.inverse_mass()],
-        material: [
-            b.restitution.unwrap_or(settings.restitution),
-            b.friction.unwrap_or(settings.friction),
-            0.0,
-            0.0,
-        ],
+        material: [b.restitution.unwrap_or(settings.restitution), b.friction.unwrap_or(settings.friction), 0.0, 0.0],
         kind: [shape, if b.fixed { FLAG_FIXED } else { 0 }, 0, 0],
     }
 }

@@ -1,7 +1,6 @@
 //! `verlet run --frames`: the binary writes the frames INTERFACE.md section 3
 //! promises, and refuses bad image flags cleanly.
 
-
 mod common;
 
 use common::{no_adapter, temp_path as temp_dir, verlet};
@@ -10,8 +9,19 @@ use common::{no_adapter, temp_path as temp_dir, verlet};
 fn frames_are_written_every_k_steps_at_the_asked_size() {
     let dir = temp_dir("drop");
     let out = verlet(&[
-        "run", "--builtin", "drop", "--steps", "20", "--every", "10", "--frames", dir.to_str().unwrap(),
-        "--width", "333", "--height", "211",
+        "run",
+        "--builtin",
+        "drop",
+        "--steps",
+        "20",
+        "--every",
+        "10",
+        "--frames",
+        dir.to_str().unwrap(),
+        "--width",
+        "333",
+        "--height",
+        "211",
     ]);
     if no_adapter(&out) {
         return;
@@ -45,15 +55,28 @@ fn gif_and_contact_sheet_without_frames() {
     std::fs::create_dir_all(&dir).unwrap();
     let (gif, sheet) = (dir.join("run.gif"), dir.join("sheet.png"));
     let out = verlet(&[
-        "run", "--builtin", "drop", "--steps", "30", "--every", "10", "--gif", gif.to_str().unwrap(),
-        "--contact-sheet", sheet.to_str().unwrap(), "--width", "160", "--height", "120",
+        "run",
+        "--builtin",
+        "drop",
+        "--steps",
+        "30",
+        "--every",
+        "10",
+        "--gif",
+        gif.to_str().unwrap(),
+        "--contact-sheet",
+        sheet.to_str().unwrap(),
+        "--width",
+        "160",
+        "--height",
+        "120",
     ]);
     if no_adapter(&out) {
         return;
     }
     assert!(out.status.success(), "verlet run failed: {}", String::from_utf8_lossy(&out.stderr));
-    let decoder = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(std::fs::File::open(&gif).unwrap()))
-        .expect("a readable GIF");
+    let decoder =
+        image::codecs::gif::GifDecoder::new(std::io::BufReader::new(std::fs::File::open(&gif).unwrap())).expect("a readable GIF");
     let frames = image::AnimationDecoder::into_frames(decoder).collect_frames().expect("GIF frames decode");
     assert_eq!(frames.len(), 4, "steps 0, 10, 20, 30");
     assert_eq!(frames[0].buffer().dimensions(), (160, 120));

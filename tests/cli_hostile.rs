@@ -244,8 +244,22 @@ fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
     std::fs::write(&trace, "an old trace\n").unwrap();
     std::fs::write(&state, "an old state\n").unwrap();
     let args = [
-        "run", s(&bad), "--steps", "30", "--every", "10", "--trace", s(&trace), "--state-out", s(&state), "--frames",
-        s(&frames), "--width", "32", "--height", "24",
+        "run",
+        s(&bad),
+        "--steps",
+        "30",
+        "--every",
+        "10",
+        "--trace",
+        s(&trace),
+        "--state-out",
+        s(&state),
+        "--frames",
+        s(&frames),
+        "--width",
+        "32",
+        "--height",
+        "24",
     ];
     let (out, _) = capped(&args);
     if no_adapter(&out) {
@@ -392,7 +406,10 @@ fn negative_numbers_are_refused_saying_what_the_flag_takes() {
         assert!(line.contains("must be"), "{args:?}: says not what the flag takes: {line}");
         assert!(took < QUICK);
     }
-    assert_refused_quickly(&["run", "--builtin", "drop", "--steps", "-1"], &["--steps: must be a non-negative whole number, got -1"]);
+    assert_refused_quickly(
+        &["run", "--builtin", "drop", "--steps", "-1"],
+        &["--steps: must be a non-negative whole number, got -1"],
+    );
 }
 
 #[test]
@@ -405,10 +422,7 @@ fn malformed_scene_files_are_named_with_the_line() {
     for (file, why) in [(s(&bom), "byte-order mark"), (s(&empty), "is empty"), ("/dev/null", "is empty")] {
         assert_refused_quickly(&["run", file, "--steps", "1"], &[file, "line 1", why]);
     }
-    assert_refused_quickly(
-        &["run", "--builtin", "drop", "--steps", "1", "--input", s(&empty)],
-        &["--input", s(&empty), "line 1"],
-    );
+    assert_refused_quickly(&["run", "--builtin", "drop", "--steps", "1", "--input", s(&empty)], &["--input", s(&empty), "line 1"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

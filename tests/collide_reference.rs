@@ -104,7 +104,18 @@ fn check(a: &Obb, b: &Obb, margin: f32, m: Option<Manifold>, stats: &mut [usize;
     for p in &m.points {
         let depth = -p.separation(m.normal);
         // faces are preferred to edges by EDGE_BIAS, which bounds the excess
-        assert!(depth <= overlap.max(0.0) + EDGE_BIAS + tol, "depth {depth} > true overlap {overlap}; {} points, n {:?}, a {:?} {:?} {:?} b {:?} {:?} {:?}", m.points.len(), m.normal, a.c, a.q, a.h, b.c, b.q, b.h);
+        assert!(
+            depth <= overlap.max(0.0) + EDGE_BIAS + tol,
+            "depth {depth} > true overlap {overlap}; {} points, n {:?}, a {:?} {:?} {:?} b {:?} {:?} {:?}",
+            m.points.len(),
+            m.normal,
+            a.c,
+            a.q,
+            a.h,
+            b.c,
+            b.q,
+            b.h
+        );
         assert!(depth <= overlap_on(a, b, m.normal) + tol, "depth {depth} beyond the overlap along the normal");
         // each point lies on its own box
         assert!(a.outside(p.on_a) < tol, "on_a off box a by {}", a.outside(p.on_a));

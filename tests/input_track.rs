@@ -28,15 +28,9 @@ fn a_track_loads_sorted_stably_and_round_trips() {
     let names: Vec<&str> = track.events().iter().map(|e| e.action.name()).collect();
     // equal times keep their file order
     assert_eq!(names, ["wind", "impulse", "impulse", "explode", "set_velocity", "set_pose", "fixed"]);
-    assert_eq!(
-        track.events()[1].action,
-        Action::Impulse { body: 7, impulse: [0.0, 0.0, 400.0], point: Some([0.1, 2.0, 0.0]) }
-    );
+    assert_eq!(track.events()[1].action, Action::Impulse { body: 7, impulse: [0.0, 0.0, 400.0], point: Some([0.1, 2.0, 0.0]) });
     assert_eq!(track.events()[2].action, Action::Impulse { body: 2, impulse: [1.0, 0.0, 0.0], point: None });
-    assert_eq!(
-        track.events()[4].action,
-        Action::SetVelocity { body: 3, linear: [1.0, 0.0, 0.0], angular: [0.0; 3] }
-    );
+    assert_eq!(track.events()[4].action, Action::SetVelocity { body: 3, linear: [1.0, 0.0, 0.0], angular: [0.0; 3] });
     assert_eq!(track.events()[6].action, Action::Fixed { body: 0, fixed: false, mass: Some(12.5) });
     match &track.events()[0].action {
         Action::Wind { wind, duration } => {
@@ -54,26 +48,56 @@ fn a_track_loads_sorted_stably_and_round_trips() {
 
 /// Each malformed track and the start of its one-line error.
 const BAD: &[(&str, &str)] = &[
-    (r#"{"events": [{"t": -1, "explode": {"centre": [0,0,0], "strength": 1, "radius": 1}}]}"#, "events[0].t: must be a finite time >= 0 s, got -1"),
+    (
+        r#"{"events": [{"t": -1, "explode": {"centre": [0,0,0], "strength": 1, "radius": 1}}]}"#,
+        "events[0].t: must be a finite time >= 0 s, got -1",
+    ),
     (r#"{"events": [{"explode": {"centre": [0,0,0], "strength": 1, "radius": 1}}]}"#, "events[0].t: is required but missing"),
-    (r#"{"events": [{"t": 1, "impulse": {"body": 0, "impulse": [1, 2]}}]}"#, "events[0].impulse.impulse: must have exactly 3 elements, got 2"),
+    (
+        r#"{"events": [{"t": 1, "impulse": {"body": 0, "impulse": [1, 2]}}]}"#,
+        "events[0].impulse.impulse: must have exactly 3 elements, got 2",
+    ),
     (r#"{"events": [{"t": 1, "impulse": {"body": 0}}]}"#, "events[0].impulse.impulse: is required but missing"),
-    (r#"{"events": [{"t": 1, "impulse": {"body": 0, "impulse": [0, 1e39, 0]}}]}"#, "events[0].impulse.impulse[1]: must be a finite number"),
-    (r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": true}}, {"t": 1, "explode": {"centre": [0,0,0], "strength": 1e400, "radius": 1}}]}"#, "events[1].explode.strength: number out of range"),
+    (
+        r#"{"events": [{"t": 1, "impulse": {"body": 0, "impulse": [0, 1e39, 0]}}]}"#,
+        "events[0].impulse.impulse[1]: must be a finite number",
+    ),
+    (
+        r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": true}}, {"t": 1, "explode": {"centre": [0,0,0], "strength": 1e400, "radius": 1}}]}"#,
+        "events[1].explode.strength: number out of range",
+    ),
     (r#"{"events": [{"t": 1e400, "fixed": {"body": 0, "fixed": true}}]}"#, "events[0].t: number out of range"),
-    (r#"{"events": [{"t": 1, "explode": {"centre": [0,0,0], "strength": 1, "radius": 0}}]}"#, "events[0].explode.radius: must be > 0"),
-    (r#"{"events": [{"t": 1, "explode": {"centre": [0,0,0], "strength": 1, "radius": 1, "falloff": -1}}]}"#, "events[0].explode.falloff: must be >= 0"),
+    (
+        r#"{"events": [{"t": 1, "explode": {"centre": [0,0,0], "strength": 1, "radius": 0}}]}"#,
+        "events[0].explode.radius: must be > 0",
+    ),
+    (
+        r#"{"events": [{"t": 1, "explode": {"centre": [0,0,0], "strength": 1, "radius": 1, "falloff": -1}}]}"#,
+        "events[0].explode.falloff: must be >= 0",
+    ),
     (r#"{"events": [{"t": 1, "impulse": {"body": -1, "impulse": [0,0,0]}}]}"#, "events[0].impulse.body: invalid value"),
-    (r#"{"events": [{"t": 1, "impulse": {"body": 0, "impulse": [0,0,0], "spin": 2}}]}"#, "events[0].impulse.spin: unknown field `spin`"),
+    (
+        r#"{"events": [{"t": 1, "impulse": {"body": 0, "impulse": [0,0,0], "spin": 2}}]}"#,
+        "events[0].impulse.spin: unknown field `spin`",
+    ),
     (r#"{"events": [{"t": 1, "push": {}}]}"#, "events[0].push: unknown field `push`"),
     (r#"{"events": [{"t": 1}]}"#, "events[0]: must have exactly one of impulse, explode"),
-    (r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": true}, "set_velocity": {"body": 0}}]}"#, "events[0]: must have exactly one of"),
-    (r#"{"events": [{"t": 1, "set_pose": {"body": 0, "position": [0,0,0], "orientation": [0,0,0,0]}}]}"#, "events[0].set_pose.orientation: must be a non-zero quaternion"),
+    (
+        r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": true}, "set_velocity": {"body": 0}}]}"#,
+        "events[0]: must have exactly one of",
+    ),
+    (
+        r#"{"events": [{"t": 1, "set_pose": {"body": 0, "position": [0,0,0], "orientation": [0,0,0,0]}}]}"#,
+        "events[0].set_pose.orientation: must be a non-zero quaternion",
+    ),
     (r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": "yes"}}]}"#, "events[0].fixed.fixed: invalid type"),
     (r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": false, "mass": 0}}]}"#, "events[0].fixed.mass: must be > 0"),
     (r#"{"events": [{"t": 1, "wind": {"velocity": [1,0,0]}}]}"#, "events[0].wind.duration: is required but missing"),
     (r#"{"events": [{"t": 1, "wind": {"velocity": [1,0,0], "duration": 0}}]}"#, "events[0].wind.duration: must be > 0"),
-    (r#"{"events": [{"t": 1, "wind": {"velocity": [1,0,0], "duration": 1, "gust_period": 0}}]}"#, "events[0].wind.gust_period: must be > 0"),
+    (
+        r#"{"events": [{"t": 1, "wind": {"velocity": [1,0,0], "duration": 1, "gust_period": 0}}]}"#,
+        "events[0].wind.gust_period: must be > 0",
+    ),
     (r#"{"events": [{"t": 1, "wind": {"velocity": [1,0,0], "duration": 1, "drag": -1}}]}"#, "events[0].wind.drag: must be >= 0"),
     (r#"{"events": [[1, {}]]}"#, "events[0]: invalid type: sequence, expected a JSON object"),
     (r#"{}"#, "events: is required but missing"),
@@ -142,7 +166,13 @@ fn event_times_map_to_the_step_that_starts_there() {
 fn free_scene() -> Scene {
     let mut b = sphere_body(0.5, [0.0, 2.0, 0.0]);
     b.linear_velocity = [0.5, 0.0, 0.0];
-    Scene { settings: Settings { gravity: [0.0; 3], ..Settings::default() }, ground: None, bodies: vec![b], joints: vec![], camera: None }
+    Scene {
+        settings: Settings { gravity: [0.0; 3], ..Settings::default() },
+        ground: None,
+        bodies: vec![b],
+        joints: vec![],
+        camera: None,
+    }
 }
 
 #[test]
@@ -278,13 +308,26 @@ fn an_input_file_replaces_blasts_default_track() {
 fn the_command_line_refuses_a_bad_track_before_running() {
     let track = temp_path("bad.json");
     for (text, want) in [
-        (r#"{"events": [{"t": 1, "explode": {"centre": [0, 0], "strength": 1, "radius": 1}}]}"#, "error: events[0].explode.centre: must have exactly 3 elements, got 2"),
-        (r#"{"events": [{"t": 1, "impulse": {"body": 60, "impulse": [0, 0, 1]}}]}"#, "error: events[0].impulse.body: no body 60 (the scene has 60 bodies)"),
+        (
+            r#"{"events": [{"t": 1, "explode": {"centre": [0, 0], "strength": 1, "radius": 1}}]}"#,
+            "error: events[0].explode.centre: must have exactly 3 elements, got 2",
+        ),
+        (
+            r#"{"events": [{"t": 1, "impulse": {"body": 60, "impulse": [0, 0, 1]}}]}"#,
+            "error: events[0].impulse.body: no body 60 (the scene has 60 bodies)",
+        ),
     ] {
         std::fs::write(&track, text).unwrap();
         let state = temp_path("never.json");
         let out = verlet(&[
-            "run", "--builtin", "blast", "--steps", "10", "--input", track.to_str().unwrap(), "--state-out",
+            "run",
+            "--builtin",
+            "blast",
+            "--steps",
+            "10",
+            "--input",
+            track.to_str().unwrap(),
+            "--state-out",
             state.to_str().unwrap(),
         ]);
         let stderr = String::from_utf8_lossy(&out.stderr);

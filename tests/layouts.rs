@@ -38,9 +38,27 @@ fn shared_structs_match_member_by_member() {
     check_layout!(
         common,
         Params {
-            gravity, dt, dt_prev, relaxation, linear_damping, angular_damping, body_count, has_ground,
-            ground_restitution, ground_friction, cell_size, hash_size, large_count, speculative,
-            substeps, step_index, sleep_after, substep, opaque_zero, _pad4, _pad5
+            gravity,
+            dt,
+            dt_prev,
+            relaxation,
+            linear_damping,
+            angular_damping,
+            body_count,
+            has_ground,
+            ground_restitution,
+            ground_friction,
+            cell_size,
+            hash_size,
+            large_count,
+            speculative,
+            substeps,
+            step_index,
+            sleep_after,
+            substep,
+            opaque_zero,
+            _pad4,
+            _pad5
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });
@@ -79,7 +97,9 @@ fn constants_match() {
     };
     assert!(matches!(constant("NO_FAULT"), naga::Expression::Literal(naga::Literal::U32(verlet::world::NO_FAULT))));
     assert!(matches!(constant("MAX_SPEED"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_SPEED));
-    assert!(matches!(constant("MAX_DISTANCE"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_DISTANCE));
+    assert!(
+        matches!(constant("MAX_DISTANCE"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_DISTANCE)
+    );
     assert!(matches!(constant("MAX_SPIN"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_SPIN));
     assert!(matches!(constant("MAX_TURN"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_TURN));
     for (name, code) in [("FAULT_NON_FINITE", 0u32), ("FAULT_FAR", 1), ("FAULT_FAST", 2), ("FAULT_SPIN", 3)] {

@@ -100,8 +100,7 @@ fn projectiles_far_from_the_origin_stay_on_their_parabolas() {
     let v0 = [3.3, 10.7, -2.9];
     for substeps in [Settings::default().substeps, 8] {
         let Some(worst) = parabola_errors(&starts, v0, substeps) else { return };
-        let report: Vec<String> =
-            starts.iter().zip(&worst).map(|(x0, e)| format!("from {x0:?}: {:.3} mm", e * 1e3)).collect();
+        let report: Vec<String> = starts.iter().zip(&worst).map(|(x0, e)| format!("from {x0:?}: {:.3} mm", e * 1e3)).collect();
         eprintln!("{substeps} substeps, farthest from the parabola over 2 s: {}", report.join(", "));
         assert!(
             worst.iter().all(|&e| e < 0.002),

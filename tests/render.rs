@@ -71,8 +71,7 @@ fn check_golden(name: &str, actual: &RgbaImage) {
         eprintln!("golden {name}: wrote {} ({why}); check it by eye and commit it", expected_path.display());
         return;
     }
-    let expected =
-        image::open(&expected_path).unwrap_or_else(|e| panic!("{}: {e}", expected_path.display())).to_rgba8();
+    let expected = image::open(&expected_path).unwrap_or_else(|e| panic!("{}: {e}", expected_path.display())).to_rgba8();
     let actual_path = dir.join(format!("{name}.actual.png"));
     if expected.dimensions() != actual.dimensions() {
         render::write_png(actual, &actual_path).unwrap();
@@ -98,11 +97,7 @@ fn check_golden(name: &str, actual: &RgbaImage) {
             diff_path.display()
         );
     }
-    eprintln!(
-        "golden {name}: mean abs {:.3}/255, {:.3}% of pixels over {PIXEL_THRESHOLD}",
-        d.mean_abs,
-        100.0 * d.share_over
-    );
+    eprintln!("golden {name}: mean abs {:.3}/255, {:.3}% of pixels over {PIXEL_THRESHOLD}", d.mean_abs, 100.0 * d.share_over);
 }
 
 /// Renders `scene` after `steps` steps, or None when the test must skip.
@@ -258,9 +253,7 @@ fn bad_sizes_are_refused_naming_the_flag() {
     let Some(gpu) = common::gpu() else { return };
     let scene = scenes::drop();
     let max = gpu.limits.max_texture_dimension_2d;
-    for (w, h, flag) in
-        [(0, 240, "--width"), (320, 0, "--height"), (max + 1, 240, "--width"), (320, max + 1, "--height")]
-    {
+    for (w, h, flag) in [(0, 240, "--width"), (320, 0, "--height"), (max + 1, 240, "--width"), (320, max + 1, "--height")] {
         match Renderer::new(&gpu, &scene, w, h) {
             Err(Error::Input(msg)) => assert!(msg.contains(flag), "{w}x{h}: {msg}"),
             Err(e) => panic!("{w}x{h}: wrong error {e}"),

@@ -39,16 +39,81 @@ const ROOTS: &[&str] = &["scene", "settings", "ground", "bodies", "joints", "cam
 
 /// Names and tokens that steer mutations towards what the loader knows.
 const KEYS: &[&str] = &[
-    "settings", "dt", "gravity", "iterations", "relaxation", "linear_damping", "angular_damping", "restitution",
-    "friction", "substeps", "sleeping", "ground", "height", "bodies", "shape", "type", "box", "sphere", "half_extents", "radius",
-    "position", "orientation", "linear_velocity", "angular_velocity", "density", "mass", "fixed", "joints", "ball",
-    "anchors", "camera", "target", "fov_y", "", "x", "\n", "bodies[0]",
+    "settings",
+    "dt",
+    "gravity",
+    "iterations",
+    "relaxation",
+    "linear_damping",
+    "angular_damping",
+    "restitution",
+    "friction",
+    "substeps",
+    "sleeping",
+    "ground",
+    "height",
+    "bodies",
+    "shape",
+    "type",
+    "box",
+    "sphere",
+    "half_extents",
+    "radius",
+    "position",
+    "orientation",
+    "linear_velocity",
+    "angular_velocity",
+    "density",
+    "mass",
+    "fixed",
+    "joints",
+    "ball",
+    "anchors",
+    "camera",
+    "target",
+    "fov_y",
+    "",
+    "x",
+    "\n",
+    "bodies[0]",
 ];
 
 const TOKENS: &[&str] = &[
-    "{", "}", "[", "]", ",", ":", "\"", "\\", "-", ".", "e", "E", "0", "1", "-1", "1e400", "-1e400", "1e39", "NaN",
-    "Infinity", "null", "true", "false", "4294967296", "18446744073709551616", "-0", "1e-45", "\"box\"", "\"ball\"",
-    "\"sphere\"", "\u{0}", "\u{feff}", "é", "\n", " ",
+    "{",
+    "}",
+    "[",
+    "]",
+    ",",
+    ":",
+    "\"",
+    "\\",
+    "-",
+    ".",
+    "e",
+    "E",
+    "0",
+    "1",
+    "-1",
+    "1e400",
+    "-1e400",
+    "1e39",
+    "NaN",
+    "Infinity",
+    "null",
+    "true",
+    "false",
+    "4294967296",
+    "18446744073709551616",
+    "-0",
+    "1e-45",
+    "\"box\"",
+    "\"ball\"",
+    "\"sphere\"",
+    "\u{0}",
+    "\u{feff}",
+    "é",
+    "\n",
+    " ",
 ];
 
 /// Whether an error message has the form the contract asks for.
@@ -243,8 +308,26 @@ fn text_mutations_of_a_valid_scene_never_panic() {
 fn json_value() -> impl Strategy<Value = Value> {
     let number = prop_oneof![
         proptest::sample::select(vec![
-            0.0, -0.0, 1.0, -1.0, 0.5, 2.0, 3.0, 1e-45, 1e-300, 3.5e38, 1e39, 1e300, -1e300, 4294967296.0, 0.1, 256.0, 257.0,
-            65.0, 1e6, -2.0,
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            2.0,
+            3.0,
+            1e-45,
+            1e-300,
+            3.5e38,
+            1e39,
+            1e300,
+            -1e300,
+            4294967296.0,
+            0.1,
+            256.0,
+            257.0,
+            65.0,
+            1e6,
+            -2.0,
         ])
         .prop_map(|x: f64| serde_json::json!(x)),
         any::<f64>().prop_map(|x| serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)),
@@ -349,8 +432,7 @@ fn apply_tree(edits: &[TreeEdit]) -> String {
 
 #[test]
 fn tree_mutations_of_a_valid_scene_never_panic() {
-    let [loaded, field, position] =
-        run(2000, proptest::collection::vec(tree_edit(), 1..4).prop_map(|edits| apply_tree(&edits)));
+    let [loaded, field, position] = run(2000, proptest::collection::vec(tree_edit(), 1..4).prop_map(|edits| apply_tree(&edits)));
     assert!(loaded > 0 && field > 1000, "the edits should mostly reach the checks of values");
     assert_eq!(position, 0, "a tree written by serde_json is always well-formed JSON");
 }

@@ -18,8 +18,7 @@ fn bad_scenes_dir() -> PathBuf {
 /// errors, which name a line and column instead).
 fn expected_paths() -> BTreeMap<String, String> {
     let path = bad_scenes_dir().join("expected.json");
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -79,12 +78,7 @@ fn verlet_run_refuses_bad_scenes() {
     for (name, path) in expected_paths() {
         let file = bad_scenes_dir().join(&name);
         let output = Command::new(env!("CARGO_BIN_EXE_verlet"))
-            .args([
-                "run".as_ref(),
-                file.as_os_str(),
-                "--steps".as_ref(),
-                "1".as_ref(),
-            ])
+            .args(["run".as_ref(), file.as_os_str(), "--steps".as_ref(), "1".as_ref()])
             .output()
             .expect("verlet binary runs");
         let stderr = String::from_utf8_lossy(&output.stderr);

@@ -27,7 +27,9 @@ fn the_input_kernels_validate() {
         assert!(module.entry_points.iter().any(|e| e.name == name), "input.wgsl: no entry point {name}");
     }
     // the host twins match the WGSL structs' sizes
-    for (name, size) in [("InputHeader", std::mem::size_of::<input::InputHeader>()), ("InputOp", std::mem::size_of::<input::InputOp>())] {
+    for (name, size) in
+        [("InputHeader", std::mem::size_of::<input::InputHeader>()), ("InputOp", std::mem::size_of::<input::InputOp>())]
+    {
         let ty = module
             .types
             .iter()

@@ -55,7 +55,12 @@ fn impulse_at_the_centre_changes_velocity_by_j_over_m() {
     let err_now = rel_err(d3(now.linear_velocity) - d3(before.linear_velocity), want);
     let err = rel_err(d3(after.linear_velocity) - d3(before.linear_velocity), want);
     let spin = d3(after.angular_velocity).length();
-    eprintln!("impulse at centre: |dv| {:.5} m/s, error {:.2e} at once, {:.2e} after a step; spin {spin:.2e} rad/s", want.length(), err_now, err);
+    eprintln!(
+        "impulse at centre: |dv| {:.5} m/s, error {:.2e} at once, {:.2e} after a step; spin {spin:.2e} rad/s",
+        want.length(),
+        err_now,
+        err
+    );
     assert!(err_now < 0.01 && err < 0.01, "velocity change off by {:.3}% / {:.3}%", err_now * 100.0, err * 100.0);
     assert!(spin < 1e-4, "a central impulse spun the body at {spin} rad/s");
     // the position moved on by the new velocity
@@ -184,7 +189,8 @@ fn a_new_pose_keeps_the_velocity() {
 
 /// Spheres at known distances from an explosion; some beyond its radius.
 fn blast_scene(settings: Settings) -> (Scene, Vec<f64>) {
-    let dirs = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-0.6, 0.8, 0.0], [0.0, -0.6, 0.8], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let dirs =
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-0.6, 0.8, 0.0], [0.0, -0.6, 0.8], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     let dists = [1.0, 2.0, 3.0, 4.0, 4.5, 6.0, 9.0];
     let bodies = dirs
         .iter()
@@ -489,7 +495,14 @@ fn a_kinematic_paddle_moved_by_set_pose_pushes_boxes_without_passing_through() {
     }
     let s = w.read_state().unwrap();
     let x = -1.0 + speed * dt * 90.0;
-    eprintln!("paddle at 2 m/s: deepest overlap {:.1} mm; boxes end at x = {:.3} {:.3} {:.3}, paddle front at {:.3}", deepest * 1e3, s[1].position[0], s[2].position[0], s[3].position[0], x + 0.1);
+    eprintln!(
+        "paddle at 2 m/s: deepest overlap {:.1} mm; boxes end at x = {:.3} {:.3} {:.3}, paddle front at {:.3}",
+        deepest * 1e3,
+        s[1].position[0],
+        s[2].position[0],
+        s[3].position[0],
+        x + 0.1
+    );
     assert!(deepest < 0.03, "the paddle sank {deepest} m into a box");
     for (k, b) in s.iter().enumerate().take(4).skip(1) {
         assert!(b.position[0] as f64 >= x + 0.1 + 0.25 - 0.03, "box {k} left behind at {:?}", b.position);

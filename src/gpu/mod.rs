@@ -137,7 +137,13 @@ impl Gpu {
                     _ => "the driver gave no reason",
                 };
                 let message = message.replace('\n', " ");
-                first.get_or_insert_with(|| if message.trim().is_empty() { reason.to_string() } else { format!("{reason}: {message}") });
+                first.get_or_insert_with(|| {
+                    if message.trim().is_empty() {
+                        reason.to_string()
+                    } else {
+                        format!("{reason}: {message}")
+                    }
+                });
             }
         });
         Ok(Gpu { adapter, device, queue, info, limits, errors, lost, polling: std::sync::Mutex::new(()) })
@@ -205,10 +211,7 @@ impl Gpu {
         rx.recv_timeout(WAIT_SLICE)
             .map_err(|_| GpuError::Runtime("the readback's mapping never completed".into()))?
             .map_err(|e| GpuError::Runtime(e.to_string()))?;
-        let bytes = staging
-            .get_mapped_range(..)
-            .map_err(|e| GpuError::Runtime(e.to_string()))?
-            .to_vec();
+        let bytes = staging.get_mapped_range(..).map_err(|e| GpuError::Runtime(e.to_string()))?.to_vec();
         staging.unmap();
         Ok(bytes)
     }
@@ -248,9 +251,8 @@ pub fn quiet_window_system_probe() {
     if cfg!(all(unix, not(target_os = "macos"), not(target_os = "android"))) {
         let absolute = |var: &str| std::env::var_os(var).is_some_and(|v| v.as_encoded_bytes().first() == Some(&b'/'));
         // WAYLAND_SOCKET, an inherited connection, is used without a probe
-        let probe_complains = std::env::var_os("WAYLAND_SOCKET").is_none()
-            && !absolute("XDG_RUNTIME_DIR")
-            && !absolute("WAYLAND_DISPLAY");
+        let probe_complains =
+            std::env::var_os("WAYLAND_SOCKET").is_none() && !absolute("XDG_RUNTIME_DIR") && !absolute("WAYLAND_DISPLAY");
         if probe_complains {
             std::env::set_var("WAYLAND_DISPLAY", "/dev/null");
         }

@@ -57,18 +57,13 @@ pub fn collide(a: &Placed, b: &Placed, margin: f32) -> Option<Manifold> {
     match (a.shape, b.shape) {
         (ShapeKind::Sphere(ra), ShapeKind::Sphere(rb)) => sphere_sphere(a.centre, ra, b.centre, rb, margin),
         (ShapeKind::Box(h), ShapeKind::Sphere(r)) => box_sphere(a.centre, a.rot, h, b.centre, r, margin),
-        (ShapeKind::Sphere(r), ShapeKind::Box(h)) => {
-            box_sphere(b.centre, b.rot, h, a.centre, r, margin).map(|m| flip(&m))
-        }
+        (ShapeKind::Sphere(r), ShapeKind::Box(h)) => box_sphere(b.centre, b.rot, h, a.centre, r, margin).map(|m| flip(&m)),
         (ShapeKind::Box(ha), ShapeKind::Box(hb)) => box_box(a.centre, a.rot, ha, b.centre, b.rot, hb, margin),
     }
 }
 
 fn flip(m: &Manifold) -> Manifold {
-    Manifold {
-        normal: -m.normal,
-        points: m.points.iter().map(|p| ContactPoint { on_a: p.on_b, on_b: p.on_a }).collect(),
-    }
+    Manifold { normal: -m.normal, points: m.points.iter().map(|p| ContactPoint { on_a: p.on_b, on_b: p.on_a }).collect() }
 }
 
 pub fn sphere_sphere(ca: Vec3, ra: f32, cb: Vec3, rb: f32, margin: f32) -> Option<Manifold> {
@@ -92,7 +87,13 @@ pub fn box_sphere(cb: Vec3, rot: Quat, h: Vec3, cs: Vec3, r: f32, margin: f32) -
     } else {
         // centre inside the box: leave through the nearest face
         let room = h - local.abs();
-        let k = if room.x <= room.y && room.x <= room.z { 0 } else if room.y <= room.z { 1 } else { 2 };
+        let k = if room.x <= room.y && room.x <= room.z {
+            0
+        } else if room.y <= room.z {
+            1
+        } else {
+            2
+        };
         let sign = if local[k] >= 0.0 { 1.0 } else { -1.0 };
         let mut n = Vec3::ZERO;
         n[k] = sign;
@@ -117,7 +118,8 @@ pub fn box_box(ca: Vec3, qa: Quat, ha: Vec3, cb: Vec3, qb: Quat, hb: Vec3, margi
     let axes_a = [ra.x_axis, ra.y_axis, ra.z_axis];
     let axes_b = [rb.x_axis, rb.y_axis, rb.z_axis];
     let d = cb - ca;
-    let proj = |axes: &[Vec3; 3], h: Vec3, l: Vec3| h.x * axes[0].dot(l).abs() + h.y * axes[1].dot(l).abs() + h.z * axes[2].dot(l).abs();
+    let proj =
+        |axes: &[Vec3; 3], h: Vec3, l: Vec3| h.x * axes[0].dot(l).abs() + h.y * axes[1].dot(l).abs() + h.z * axes[2].dot(l).abs();
     // separation along an axis (unit), and the axis turned to point from a to b
     let test = |l: Vec3| {
         let s = d.dot(l);
@@ -175,11 +177,8 @@ pub fn box_box(ca: Vec3, qa: Quat, ha: Vec3, cb: Vec3, qb: Quat, hb: Vec3, margi
 
     let (_, n, k) = best_face;
     // reference box owns the face; incident box is the other, n points ref -> inc
-    let (ref_c, ref_axes, ref_h, inc_c, inc_axes, inc_h, ref_n, flipped) = if k < 3 {
-        (ca, axes_a, ha, cb, axes_b, hb, n, false)
-    } else {
-        (cb, axes_b, hb, ca, axes_a, ha, -n, true)
-    };
+    let (ref_c, ref_axes, ref_h, inc_c, inc_axes, inc_h, ref_n, flipped) =
+        if k < 3 { (ca, axes_a, ha, cb, axes_b, hb, n, false) } else { (cb, axes_b, hb, ca, axes_a, ha, -n, true) };
     let face = k % 3;
     // incident face: the face of the incident box most anti-parallel to ref_n
     let mut inc_face = 0;

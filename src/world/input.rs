@@ -150,7 +150,10 @@ impl Wind {
             }
         }
         if !(self.gust_period.is_finite() && self.gust_period > 0.0) {
-            return Err(Error::Input(format!("wind.gust_period: must be a positive finite number of seconds, got {}", self.gust_period)));
+            return Err(Error::Input(format!(
+                "wind.gust_period: must be a positive finite number of seconds, got {}",
+                self.gust_period
+            )));
         }
         Ok(())
     }
@@ -324,11 +327,7 @@ impl World {
 
     fn input_header(&self, ops: usize) -> InputHeader {
         let g = self.settings.gravity;
-        InputHeader {
-            gravity: [g[0], g[1], g[2], self.dt_prev],
-            counts: [self.body_count, ops as u32, 0, 0],
-            ..Default::default()
-        }
+        InputHeader { gravity: [g[0], g[1], g[2], self.dt_prev], counts: [self.body_count, ops as u32, 0, 0], ..Default::default() }
     }
 
     /// Validates `inputs` (naming bad ones after `list`, or plainly when it
@@ -339,11 +338,7 @@ impl World {
             let at = |name: &str| if list.is_empty() { name.to_string() } else { format!("{list}[{k}].{name}") };
             let body = input.body();
             if body >= self.body_count as usize {
-                return Err(Error::Input(format!(
-                    "{}: no body {body} (the world has {} bodies)",
-                    at("body"),
-                    self.body_count
-                )));
+                return Err(Error::Input(format!("{}: no body {body} (the world has {} bodies)", at("body"), self.body_count)));
             }
             let mut op = InputOp { body: body as u32, ..Default::default() };
             match *input {
@@ -423,10 +418,8 @@ impl World {
         }
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("input") });
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(ENTRY_POINTS[kernel]),
-                timestamp_writes: None,
-            });
+            let mut pass = encoder
+                .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(ENTRY_POINTS[kernel]), timestamp_writes: None });
             let threads = if kernel == APPLY { ops.len() } else { self.body_count as usize };
             pass.set_bind_group(0, &input.bind_groups[self.current], &[]);
             pass.set_pipeline(&input.pipelines[kernel]);
@@ -535,5 +528,4 @@ impl World {
             }
         }
     }
-
 }

@@ -170,13 +170,7 @@ impl Snapshot {
                     };
                 }
                 let second = v4(1);
-                BodyState {
-                    pos,
-                    disp: [second[0], second[1], second[2]],
-                    pos_low: u32_at(at + 28),
-                    rot: v4(2),
-                    prev_rot: v4(3),
-                }
+                BodyState { pos, disp: [second[0], second[1], second[2]], pos_low: u32_at(at + 28), rot: v4(2), prev_rot: v4(3) }
             })
             .collect();
         Ok(Snapshot { step, time, dt_prev, scene_hash, states })
@@ -243,7 +237,17 @@ impl World {
         let mut h = FNV_OFFSET;
         let mut put = |bytes: &[u8]| h = fnv1a(h, bytes);
         put(&self.body_count.to_le_bytes());
-        for v in [s.dt, s.gravity[0], s.gravity[1], s.gravity[2], s.relaxation, s.linear_damping, s.angular_damping, s.restitution, s.friction] {
+        for v in [
+            s.dt,
+            s.gravity[0],
+            s.gravity[1],
+            s.gravity[2],
+            s.relaxation,
+            s.linear_damping,
+            s.angular_damping,
+            s.restitution,
+            s.friction,
+        ] {
             put(&v.to_bits().to_le_bytes());
         }
         put(&s.iterations.to_le_bytes());
