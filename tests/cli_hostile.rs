@@ -532,3 +532,29 @@ fn help_lists_every_built_in_scene() {
         assert!(took < QUICK, "{args:?}: took {took:?}");
     }
 }
+
+#[test]
+fn two_bodies_placed_in_one_spot_separate_no_faster_than_promised() {
+    // The README's promise: old overlap between two bodies is pushed out at
+    // most 3 m/s. (Many bodies in one spot add their pairs' speeds up: ten
+    // boxes spread at 13 m/s; see the notes.)
+    let cube = || scenes::box_body([0.5; 3], [0.0, 2.0, 0.0]);
+    for (name, second) in [("two boxes", cube()), ("a box and a ball", scenes::sphere_body(0.5, [0.0, 2.0, 0.0]))] {
+        let mut scene = scenes::stack(0);
+        scene.ground = None;
+        scene.settings.gravity = [0.0; 3];
+        scene.bodies = vec![cube(), second];
+        let Some(mut w) = common::world(&scene) else { return };
+        let mut fastest = 0.0f32;
+        for _ in 0..120 {
+            w.step(1).unwrap();
+            let state = w.read_state().unwrap();
+            fastest = state.iter().map(|b| common::v3(b.linear_velocity).length()).fold(fastest, f32::max);
+        }
+        let state = w.read_state().unwrap();
+        let apart = (common::v3(state[0].position) - common::v3(state[1].position)).length();
+        eprintln!("{name}: fastest {fastest:.2} m/s, centres {apart:.3} m apart after 2 s");
+        assert!(fastest <= 3.0, "{name}: separated at {fastest} m/s");
+        assert!(apart > 1.0, "{name}: still overlapping after 2 s, centres {apart} m apart");
+    }
+}
