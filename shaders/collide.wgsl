@@ -134,29 +134,31 @@ fn closest_on_edges(pa: vec3<f32>, da: vec3<f32>, la: f32, pb: vec3<f32>, db: ve
     *out_b = pb + db * t;
 }
 
-var<private> poly: array<vec3<f32>, 8>;
-var<private> poly_len: u32;
+// The clipped polygon, in two buffers that the four clips write in turn
+// (the next clip reads what the last wrote; no copying between them).
+var<private> poly_a: array<vec3<f32>, 8>;
+var<private> poly_b: array<vec3<f32>, 8>;
 
-// Sutherland-Hodgman: keep the part of the polygon with dot(p, n) <= offset.
-fn clip_poly(n: vec3<f32>, offset: f32) {
-    var out: array<vec3<f32>, 8>;
-    var len = 0u;
-    for (var i = 0u; i < poly_len; i = i + 1u) {
-        let p = poly[i];
-        let q = poly[(i + 1u) % poly_len];
+// Sutherland-Hodgman: the part of polygon `src` (len points) with
+// dot(p, n) <= offset, into `dst`; returns its length.
+fn clip_poly(src: ptr<private, array<vec3<f32>, 8>>, len: u32, dst: ptr<private, array<vec3<f32>, 8>>,
+             n: vec3<f32>, offset: f32) -> u32 {
+    var out_len = 0u;
+    for (var i = 0u; i < len; i = i + 1u) {
+        let p = (*src)[i];
+        let q = (*src)[(i + 1u) % len];
         let dp = dot(p, n) - offset;
         let dq = dot(q, n) - offset;
-        if (dp <= 0.0 && len < 8u) {
-            out[len] = p;
-            len = len + 1u;
+        if (dp <= 0.0 && out_len < 8u) {
+            (*dst)[out_len] = p;
+            out_len = out_len + 1u;
         }
-        if ((dp <= 0.0) != (dq <= 0.0) && len < 8u) {
-            out[len] = p + (q - p) * (dp / (dp - dq));
-            len = len + 1u;
+        if ((dp <= 0.0) != (dq <= 0.0) && out_len < 8u) {
+            (*dst)[out_len] = p + (q - p) * (dp / (dp - dq));
+            out_len = out_len + 1u;
         }
     }
-    poly = out;
-    poly_len = len;
+    return out_len;
 }
 
 // The separating-axis test of two boxes within `margin`: the axis of
@@ -306,27 +308,28 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let v = (inc_face + 2u) % 3u;
     let eu = inc_axes[u] * inc_h[u];
     let ev = inc_axes[v] * inc_h[v];
-    poly[0] = inc_centre + eu + ev;
-    poly[1] = inc_centre - eu + ev;
-    poly[2] = inc_centre - eu - ev;
-    poly[3] = inc_centre + eu - ev;
-    poly_len = 4u;
+    poly_a[0] = inc_centre + eu + ev;
+    poly_a[1] = inc_centre - eu + ev;
+    poly_a[2] = inc_centre - eu - ev;
+    poly_a[3] = inc_centre + eu - ev;
 
-    // clip against the four side planes of the reference face
+    // clip against the four side planes of the reference face: the two
+    // faces along its first side axis, then along its second
     let ref_centre = ref_c + ref_n * ref_h[face];
-    for (var e = 1u; e < 3u; e = e + 1u) {
-        let side = (face + e) % 3u;
-        for (var sgn = 0u; sgn < 2u; sgn = sgn + 1u) {
-            let plane_n = ref_axes[side] * select(-1.0, 1.0, sgn == 0u);
-            clip_poly(plane_n, dot(plane_n, ref_c) + ref_h[side]);
-        }
-    }
+    let side_u = (face + 1u) % 3u;
+    let side_v = (face + 2u) % 3u;
+    let u_n = ref_axes[side_u];
+    let v_n = ref_axes[side_v];
+    var poly_len = clip_poly(&poly_a, 4u, &poly_b, u_n, dot(u_n, ref_c) + ref_h[side_u]);
+    poly_len = clip_poly(&poly_b, poly_len, &poly_a, -u_n, dot(-u_n, ref_c) + ref_h[side_u]);
+    poly_len = clip_poly(&poly_a, poly_len, &poly_b, v_n, dot(v_n, ref_c) + ref_h[side_v]);
+    poly_len = clip_poly(&poly_b, poly_len, &poly_a, -v_n, dot(-v_n, ref_c) + ref_h[side_v]);
     // keep points within the margin of the reference face
     var pts_a: array<vec3<f32>, 8>;
     var pts_b: array<vec3<f32>, 8>;
     var count = 0u;
     for (var k = 0u; k < poly_len; k = k + 1u) {
-        let p = poly[k];
+        let p = poly_a[k];
         let sep = dot(p - ref_centre, ref_n);
         if (sep <= margin) {
             let on_ref = p - ref_n * sep;
