@@ -43,3 +43,8 @@
 fn large_body(k: u32) -> u32 {
     return sorted[params.body_count - params.large_count + k];
 }
+
+// The manifolds this step's narrowphase stored (status[4], within the pool).
+fn manifolds_used() -> u32 {
+    return min(atomicLoad(&status[4]), arrayLength(&manifolds));
+}

@@ -180,7 +180,7 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = gid.x;
-    if (k >= min(atomicLoad(&status[4]), arrayLength(&manifolds))) {
+    if (k >= manifolds_used()) {
         return;
     }
     let face = manifolds[k].clip_face;
@@ -205,7 +205,7 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i == 0u) {
-        let used = min(atomicLoad(&status[4]), arrayLength(&manifolds));
+        let used = manifolds_used();
         atomicStore(&status[12], (used + WORKGROUP - 1u) / WORKGROUP);
         atomicStore(&status[13], 1u);
         atomicStore(&status[14], 1u);

@@ -48,7 +48,7 @@ fn end_velocity_before(i: u32) -> Velocity {
 @compute @workgroup_size(WORKGROUP)
 fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = gid.x;
-    if (k >= min(atomicLoad(&status[4]), arrayLength(&manifolds))) {
+    if (k >= manifolds_used()) {
         return;
     }
     let a = manifolds[k].a;

@@ -41,7 +41,7 @@ fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>
 @compute @workgroup_size(WORKGROUP)
 fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = gid.x;
-    if (k >= min(atomicLoad(&status[4]), arrayLength(&manifolds))) {
+    if (k >= manifolds_used()) {
         return;
     }
     let ea = contact_end(manifolds[k].a);
