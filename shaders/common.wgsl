@@ -16,7 +16,8 @@
 // the f32 grid is 6e-5 m, and a steady horizontal displacement rounded the
 // same way every substep (21 mm in 2 s at 8 substeps).
 struct BodyState {
-    pos: vec4<f32>,      // xyz = centre of mass (m); w = seconds at rest (see `asleep`)
+    pos: vec3<f32>,      // centre of mass (m)
+    rest_time: f32,      // seconds at rest (see `asleep`)
     disp: vec3<f32>,     // x_n - x_(n-1): how far the centre moved over the last substep (m)
     pos_low: u32,        // bits 0-29: pos's rounding remainder (`pos_remainder`); bit 31: HELD
     rot: vec4<f32>,      // orientation, unit quaternion
@@ -42,7 +43,7 @@ fn remainder_unit(x: vec3<f32>) -> vec3<f32> {
 // 10-19 y, 20-29 z, offset by 512), so it holds about 1/1000 of a spacing.
 fn pos_remainder(s: BodyState) -> vec3<f32> {
     let q = (vec3<u32>(s.pos_low) >> vec3<u32>(0u, 10u, 20u)) & vec3<u32>(0x3ffu);
-    return (vec3<f32>(q) - 512.0) * remainder_unit(s.pos.xyz);
+    return (vec3<f32>(q) - 512.0) * remainder_unit(s.pos);
 }
 
 // pos_low for a remainder r (m) of the position x, with the HELD bit of `flags`.
@@ -55,8 +56,14 @@ fn pack_remainder(r: vec3<f32>, x: vec3<f32>, flags: u32) -> u32 {
 struct BodyProps {
     half_extents: vec4<f32>, // box: xyz half extents; sphere: radius in x; w = bounding radius
     inv_inertia: vec4<f32>,  // xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg)
-    material: vec4<f32>,     // x = restitution, y = friction, zw unused
-    kind: vec4<u32>,         // x = SHAPE_*, y = FLAG_* bits, zw unused
+    restitution: f32,
+    friction: f32,
+    kept_inv_mass: f32,      // a body an input made fixed: the inverse mass to restore (1/kg); else 0
+    _pad0: f32,
+    shape: u32,              // SHAPE_*
+    flags: u32,              // FLAG_* bits
+    grid_class: u32,         // GRID_BODY, or LARGE_BODY: kept out of the grid (see grid.wgsl)
+    _pad1: u32,
 }
 
 // Velocities just after integration, before any constraint: the approach
@@ -68,7 +75,8 @@ struct Velocity {
 
 // Per-step parameters, one 256-byte slot per step of a submitted batch.
 struct Params {
-    gravity: vec4<f32>,      // xyz (m/s^2); w = ground height (m)
+    gravity: vec3<f32>,      // m/s^2
+    ground_height: f32,      // m
     dt: f32,                 // this step (s)
     dt_prev: f32,            // the step that produced disp (s)
     relaxation: f32,         // the paper's c_r
@@ -209,6 +217,10 @@ const WORLD: u32 = 0xffffffffu;
 // The partner of a contact with the ground plane.
 const GROUND: u32 = 0xffffffffu;
 
+// BodyProps.grid_class: in the broadphase grid, or too large for it.
+const GRID_BODY: u32 = 0u;
+const LARGE_BODY: u32 = 1u;
+
 const SHAPE_BOX: u32 = 0u;
 const SHAPE_SPHERE: u32 = 1u;
 const FLAG_FIXED: u32 = 1u;
@@ -297,7 +309,7 @@ fn inv_inertia_world(q: vec4<f32>, inv_i: vec3<f32>, v: vec3<f32>) -> vec3<f32> 
 }
 
 fn is_fixed(p: BodyProps) -> bool {
-    return (p.kind.y & FLAG_FIXED) != 0u;
+    return (p.flags & FLAG_FIXED) != 0u;
 }
 
 // Generalised inverse mass of a body for a unit push along dir at offset r.
@@ -313,9 +325,9 @@ fn effective_inv_mass(p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>
 // fixed. It wakes when an awake body touching it moves faster than
 // WAKE_SPEED or lies more than WAKE_DEPTH inside it, and every body wakes
 // after any user input or edit. BodyState
-// pos.w counts the seconds at rest. Bodies with joints never sleep.
+// rest_time counts the seconds at rest. Bodies with joints never sleep.
 fn asleep(s: BodyState) -> bool {
-    return params.sleep_after > 0.0 && s.pos.w >= params.sleep_after;
+    return params.sleep_after > 0.0 && s.rest_time >= params.sleep_after;
 }
 
 const SLEEP_SPEED: f32 = 0.05; // m/s
@@ -359,8 +371,8 @@ fn contact_end(i: u32) -> ContactEnd {
     }
     let s = state_in[i];
     let p = props[i];
-    return ContactEnd(s.pos.xyz, s.disp, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
-                      p.material.x, p.material.y);
+    return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
+                      p.restitution, p.friction);
 }
 
 // Generalised inverse mass of an end for a unit push along dir at offset r;

@@ -30,7 +30,7 @@ fn bucket_of(c: vec3<i32>) -> u32 {
 }
 
 fn in_grid(i: u32) -> bool {
-    return props[i].kind.z == 0u; // kind.z = 1 marks a large body
+    return props[i].grid_class == GRID_BODY;
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -50,13 +50,13 @@ fn reach_of(i: u32) -> f32 {
     let steps = f32(params.substeps);
     let ratio = params.dt / params.dt_prev * steps;
     let h = params.dt * steps;
-    return length(s.disp) * ratio + length(params.gravity.xyz) * h * h;
+    return length(s.disp) * ratio + length(params.gravity) * h * h;
 }
 
 // Half extents of body i's world box: |R| h for a box, the radius for a sphere.
 fn world_extent(i: u32) -> vec3<f32> {
     let p = props[i];
-    if (p.kind.x == SHAPE_SPHERE) {
+    if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(p.half_extents.x);
     }
     let q = state_in[i].rot;
@@ -83,7 +83,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (!in_grid(i)) {
         return;
     }
-    atomicAdd(&cell_count[bucket_of(cell_of(state_in[i].pos.xyz))], 1u);
+    atomicAdd(&cell_count[bucket_of(cell_of(state_in[i].pos))], 1u);
 }
 
 // Which prefix sum the scan passes compute (set per pipeline, see above).
@@ -215,7 +215,7 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count || !in_grid(i)) {
         return;
     }
-    let h = bucket_of(cell_of(state_in[i].pos.xyz));
+    let h = bucket_of(cell_of(state_in[i].pos));
     sorted[cell_start[h] + atomicAdd(&cell_count[h], 1u)] = i;
 }
 

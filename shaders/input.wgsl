@@ -8,10 +8,11 @@
 // implicit, so a change of velocity is a change of the previous pose:
 // v = disp / h (disp = x_n - x_(n-1), see BodyState) and the turn
 // rot * prev_rot^* = exp(w h), where h is the substep that produced them
-// (input.gravity.w).
+// (input.substep_dt).
 
 struct InputHeader {
-    gravity: vec4<f32>, // xyz = settings.gravity (m/s^2); w = h, the last substep (s)
+    gravity: vec3<f32>, // settings.gravity (m/s^2)
+    substep_dt: f32,    // h, the last substep (s)
     centre: vec4<f32>,  // explode: xyz = centre (m); w = strength, an impulse (N s)
                         // wind: xyz = wind velocity (m/s); w = air density * drag coefficient / 2
     reach: vec4<f32>,   // explode: x = radius (m), y = falloff exponent; wind: x = duration (s)
@@ -38,7 +39,7 @@ const INPUT_POSE: u32 = 1u;
 // a.xyz = linear (m/s), b.xyz = angular (rad/s, world frame)
 const INPUT_VELOCITY: u32 = 2u;
 // a.x = 1: make fixed; a.x = 0: make dynamic with mass a.y (kg), or with the
-// mass kept when it was made fixed (material.z, an inverse mass) if a.y = 0
+// mass kept when it was made fixed (kept_inv_mass) if a.y = 0
 const INPUT_FIXED: u32 = 3u;
 
 // and bindings.wgsl's state_out (binding 3): the current state buffer
@@ -60,7 +61,7 @@ fn prev_rot_for_spin(rot: vec4<f32>, w: vec3<f32>, h: f32) -> vec4<f32> {
 // Body-frame principal inverse inertia of the body's shape with mass m.
 fn shape_inv_inertia(p: BodyProps, m: f32) -> vec3<f32> {
     let h = p.half_extents.xyz;
-    if (p.kind.x == SHAPE_SPHERE) {
+    if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(1.0 / (0.4 * m * h.x * h.x));
     }
     let q = h * h;
@@ -70,7 +71,7 @@ fn shape_inv_inertia(p: BodyProps, m: f32) -> vec3<f32> {
 fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> BodyState {
     var s = s_in;
     let p = *p_in;
-    let h = input.gravity.w;
+    let h = input.substep_dt;
     let fixed = is_fixed(p);
     switch op.kind {
         case INPUT_IMPULSE: {
@@ -81,7 +82,7 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             s.disp = s.disp + j * (p.inv_inertia.w * h);
             var r = vec3<f32>(0.0);
             if (op.a.w == 1.0) {
-                r = op.b.xyz - s.pos.xyz;
+                r = op.b.xyz - s.pos;
             } else if (op.a.w == 2.0) {
                 r = quat_rotate(s.rot, op.b.xyz);
             }
@@ -93,7 +94,7 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
         case INPUT_POSE: {
             let turn = quat_mul(s.rot, quat_conj(s.prev_rot));
             let q = op.b;
-            s.pos = vec4<f32>(op.a.xyz, s.pos.w);
+            s.pos = op.a.xyz;
             s.pos_low = s.pos_low & HELD; // the new position is exact
             s.rot = q;
             if (fixed) {
@@ -113,7 +114,7 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             // for a body no contact pressed: given a velocity, it is not
             // known to rest on anything)
             let v = op.a.xyz;
-            s.disp = v * h - 0.5 * input.gravity.xyz * (h * h);
+            s.disp = v * h - 0.5 * input.gravity * (h * h);
             s.pos_low = s.pos_low & ~HELD;
             s.prev_rot = prev_rot_for_spin(s.rot, op.b.xyz, h);
         }
@@ -121,9 +122,9 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             var np = p;
             if (op.a.x == 1.0) {
                 if (!fixed) {
-                    np.material.z = p.inv_inertia.w; // kept for a later switch back
+                    np.kept_inv_mass = p.inv_inertia.w; // kept for a later switch back
                 }
-                np.kind.y = p.kind.y | FLAG_FIXED;
+                np.flags = p.flags | FLAG_FIXED;
                 np.inv_inertia = vec4<f32>(0.0);
                 s.disp = vec3<f32>(0.0);
                 s.pos_low = s.pos_low | HELD;
@@ -131,14 +132,14 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             } else if (fixed) {
                 var m = op.a.y;
                 if (m <= 0.0) {
-                    m = 1.0 / np.material.z;
+                    m = 1.0 / np.kept_inv_mass;
                 }
-                np.kind.y = p.kind.y & ~FLAG_FIXED;
+                np.flags = p.flags & ~FLAG_FIXED;
                 np.inv_inertia = vec4<f32>(shape_inv_inertia(p, m), 1.0 / m);
-                np.material.z = 0.0;
+                np.kept_inv_mass = 0.0;
                 // at rest, as the scene loader starts a body: the next steps
                 // follow x + g t^2 / 2
-                s.disp = -0.5 * input.gravity.xyz * (h * h);
+                s.disp = -0.5 * input.gravity * (h * h);
                 s.pos_low = s.pos_low & ~HELD;
                 s.prev_rot = s.rot;
             }
@@ -167,7 +168,7 @@ fn apply_inputs(@builtin(global_invocation_id) gid: vec3<u32>) {
         s = apply_op(input_ops[j], s, &p);
     }
     state_out[i] = s;
-    if (any(p.kind != p0.kind) || any(p.inv_inertia != p0.inv_inertia) || any(p.material != p0.material)) {
+    if (p.flags != p0.flags || any(p.inv_inertia != p0.inv_inertia) || p.kept_inv_mass != p0.kept_inv_mass) {
         props_rw[i] = p;
     }
 }
@@ -177,8 +178,8 @@ fn apply_inputs(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(WORKGROUP)
 fn wake_all(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i < input.counts.x && state_out[i].pos.w != 0.0) {
-        state_out[i].pos.w = 0.0;
+    if (i < input.counts.x && state_out[i].rest_time != 0.0) {
+        state_out[i].rest_time = 0.0;
     }
 }
 
@@ -198,7 +199,7 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     var s = state_out[i];
-    let d = s.pos.xyz - input.centre.xyz;
+    let d = s.pos - input.centre.xyz;
     let dist = length(d);
     let radius = input.reach.x;
     if (!(dist < radius)) {
@@ -216,14 +217,14 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
         scale = pow(base, input.reach.y);
     }
     let dv = dir * (input.centre.w * scale * p.inv_inertia.w);
-    s.disp = s.disp + dv * input.gravity.w;
+    s.disp = s.disp + dv * input.substep_dt;
     state_out[i] = s;
 }
 
 // Area (m^2) of the body's shape seen along the unit world direction u.
 fn projected_area(p: BodyProps, rot: vec4<f32>, u: vec3<f32>) -> f32 {
     let h = p.half_extents.xyz;
-    if (p.kind.x == SHAPE_SPHERE) {
+    if (p.shape == SHAPE_SPHERE) {
         return 3.14159265 * h.x * h.x;
     }
     let l = abs(quat_rotate(quat_conj(rot), u));
@@ -244,7 +245,7 @@ fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     var s = state_out[i];
-    let h = input.gravity.w;
+    let h = input.substep_dt;
     let v = s.disp / h;
     let rel = input.centre.xyz - v; // wind relative to the body
     let speed = length(rel);

@@ -65,8 +65,8 @@ fn all_finite(v: vec4<f32>) -> bool {
     return all(exponent != vec4<u32>(0x7f800000u));
 }
 
-fn near(p: vec4<f32>) -> bool {
-    return all_finite(vec4<f32>(p.xyz, 0.0)) && dot(p.xyz, p.xyz) <= MAX_DISTANCE * MAX_DISTANCE;
+fn near(p: vec3<f32>) -> bool {
+    return all_finite(vec4<f32>(p, 0.0)) && dot(p, p) <= MAX_DISTANCE * MAX_DISTANCE;
 }
 
 fn usable_rotation(q: vec4<f32>) -> bool {
@@ -76,7 +76,7 @@ fn usable_rotation(q: vec4<f32>) -> bool {
 
 // FAULT_* of a body's state, or NO_FAULT.
 fn fault_of(s: BodyState) -> u32 {
-    let finite = all_finite(vec4<f32>(s.pos.xyz, 0.0)) && all_finite(vec4<f32>(s.disp, 0.0))
+    let finite = all_finite(vec4<f32>(s.pos, 0.0)) && all_finite(vec4<f32>(s.disp, 0.0))
         && all_finite(s.rot) && all_finite(s.prev_rot);
     if (!finite) {
         return FAULT_NON_FINITE;
@@ -132,15 +132,15 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (fault != NO_FAULT) {
         report_fault(i, fault);
         var at = vec3<f32>(0.0);
-        let prev = vec4<f32>(s.pos.xyz - s.disp, 0.0);
+        let prev = s.pos - s.disp;
         // the current position's finite coordinates (a NaN in one of them
         // leaves pos - disp no better)
-        let kept = select(vec3<f32>(0.0), s.pos.xyz, (bitcast<vec3<u32>>(s.pos.xyz) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u));
+        let kept = select(vec3<f32>(0.0), s.pos, (bitcast<vec3<u32>>(s.pos) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u));
         if (near(s.pos)) {
-            at = s.pos.xyz;
+            at = s.pos;
         } else if (near(prev)) {
-            at = prev.xyz;
-        } else if (near(vec4<f32>(kept, 0.0))) {
+            at = prev;
+        } else if (near(kept)) {
             at = kept;
         }
         var q = vec4<f32>(0.0, 0.0, 0.0, 1.0);
@@ -149,12 +149,12 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         } else if (usable_rotation(s.prev_rot)) {
             q = normalize(s.prev_rot);
         }
-        state_out[i] = BodyState(vec4<f32>(at, 0.0), vec3<f32>(0.0), 0u, q, q);
+        state_out[i] = BodyState(at, 0.0, vec3<f32>(0.0), 0u, q, q);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
     if (is_fixed(p)) {
-        state_out[i] = BodyState(s.pos, vec3<f32>(0.0), HELD, s.rot, s.rot);
+        state_out[i] = BodyState(s.pos, s.rest_time, vec3<f32>(0.0), HELD, s.rot, s.rot);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
@@ -164,14 +164,14 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let resting = (s.pos_low & HELD) != 0u && joint_start[i] == joint_start[i + 1u] && point_speed(s, p) < SLEEP_SPEED;
     if (asleep(s)) {
         if (!wake) {
-            rest = s.pos.w;
+            rest = s.rest_time;
         }
     } else if (select(false, resting, params.sleep_after > 0.0)) {
-        rest = s.pos.w + dt;
+        rest = s.rest_time + dt;
     }
     if (rest >= params.sleep_after && rest > 0.0) {
         // asleep: held still where it is (resting on what pressed it)
-        state_out[i] = BodyState(vec4<f32>(s.pos.xyz, rest), vec3<f32>(0.0), s.pos_low | HELD, s.rot, s.rot);
+        state_out[i] = BodyState(s.pos, rest, vec3<f32>(0.0), s.pos_low | HELD, s.rot, s.rot);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
@@ -181,7 +181,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let carry = s.disp * (ratio * (1.0 - params.linear_damping));
     // constant acceleration: a dt (dt + dt_prev) / 2 is exact for any pair of
     // steps and equals eq. 6's a dt^2 when dt does not change
-    let accel = params.gravity.xyz * (dt * 0.5 * (dt + params.dt_prev));
+    let accel = params.gravity * (dt * 0.5 * (dt + params.dt_prev));
     let disp = carry + accel;
     // pos + disp, with what the last addition's rounding dropped added back
     // and what this one drops kept (Knuth's TwoSum, exact under
@@ -189,10 +189,10 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     // about 1/1000 of its f32 spacing instead of losing up to half a
     // spacing every substep
     let add = disp + pos_remainder(s);
-    let pos = opaque(s.pos.xyz + add);
-    let add_part = opaque(pos - s.pos.xyz);
+    let pos = opaque(s.pos + add);
+    let add_part = opaque(pos - s.pos);
     let pos_part = pos - add_part;
-    let dropped = (s.pos.xyz - pos_part) + (add - add_part);
+    let dropped = (s.pos - pos_part) + (add - add_part);
 
     // eq. 7 with no torque: repeat the last rotation q_n q_{n-1}^*, scaled by
     // the step ratio and damped by interpolation towards no rotation
@@ -202,6 +202,6 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rot = normalize(quat_mul(turn, s.rot));
     let spin = quat_to_rotvec(turn);
 
-    state_out[i] = BodyState(vec4<f32>(pos, rest), disp, pack_remainder(dropped, pos, s.pos_low), rot, s.rot);
+    state_out[i] = BodyState(pos, rest, disp, pack_remainder(dropped, pos, s.pos_low), rot, s.rot);
     vel0[i] = Velocity(vec4<f32>(disp / dt, 0.0), vec4<f32>(spin / dt, 0.0));
 }

@@ -12,12 +12,12 @@
 fn shape_of(i: u32) -> Shape {
     let s = state_in[i];
     let p = props[i];
-    return Shape(s.pos.xyz, s.rot, p.half_extents.xyz, p.kind.x);
+    return Shape(s.pos, s.rot, p.half_extents.xyz, p.shape);
 }
 
 fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
     let s = state_in[i];
-    return quat_rotate(quat_conj(s.rot), p - s.pos.xyz);
+    return quat_rotate(quat_conj(s.rot), p - s.pos);
 }
 
 // Body i against the ground, within `margin`: a sphere's lowest point, or
@@ -26,11 +26,11 @@ fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
 fn ground_manifold(i: u32, margin: f32) -> Manifold {
     let s = state_in[i];
     let p = props[i];
-    let ground = params.gravity.w;
+    let ground = params.ground_height;
     var m = empty_manifold();
     m.normal = vec3<f32>(0.0, -1.0, 0.0);
-    if (p.kind.x == SHAPE_SPHERE) {
-        let lowest = s.pos.xyz - vec3<f32>(0.0, p.half_extents.x, 0.0);
+    if (p.shape == SHAPE_SPHERE) {
+        let lowest = s.pos - vec3<f32>(0.0, p.half_extents.x, 0.0);
         if (lowest.y - ground <= margin) {
             m.count = 1u;
             m.on_a[0] = lowest;
@@ -60,7 +60,7 @@ fn ground_manifold(i: u32, margin: f32) -> Manifold {
     }
     for (var k = 0u; k < 8u; k = k + 1u) {
         if ((chosen & (1u << k)) != 0u) {
-            let w = s.pos.xyz + quat_rotate(s.rot, corner(k, p.half_extents.xyz));
+            let w = s.pos + quat_rotate(s.rot, corner(k, p.half_extents.xyz));
             m.on_a[m.count] = w;
             m.on_b[m.count] = vec3<f32>(w.x, ground, w.z);
             m.count = m.count + 1u;

@@ -74,7 +74,7 @@ fn wanted(j: u32, pos_j: vec3<f32>) -> bool {
 // Whether body i is near enough the ground for a ground pair.
 fn wants_ground(i: u32) -> bool {
     return params.has_ground != 0u && pair_meta[i].moves != 0u
-        && state_in[i].pos.y - pair_meta[i].extent.y - params.gravity.w <= CONTACT_MARGIN;
+        && state_in[i].pos.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
 }
 
 // The walking body, read once: its index, centre, bounds and whether it moves.
@@ -138,7 +138,7 @@ fn visit_cell(c: vec3<i32>, above: u32) {
     let end = cell_start[h + 1u];
     for (var k = cell_start[h]; k < end; k = k + 1u) {
         let j = sorted[k];
-        let pos_j = state_in[j].pos.xyz;
+        let pos_j = state_in[j].pos;
         if ((above == NONE || j > above) && all(cell_of(pos_j) == c)) {
             visit(j, pos_j);
         }
@@ -148,7 +148,7 @@ fn visit_cell(c: vec3<i32>, above: u32) {
 // The ground, then (for a body in the grid) its own cell and the 13 cells
 // ahead of it, then the large bodies it owns pairs with.
 fn walk(i: u32) {
-    walker = Walker(i, state_in[i].pos.xyz, pair_meta[i].extent, pair_meta[i].reach, props[i].half_extents.w,
+    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].reach, props[i].half_extents.w,
                     pair_meta[i].moves != 0u);
     owned = 0u;
     if (wants_ground(i)) {
@@ -174,7 +174,7 @@ fn walk(i: u32) {
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         let j = large_body(k);
         if (grid || j > i) {
-            visit(j, state_in[j].pos.xyz);
+            visit(j, state_in[j].pos);
         }
     }
 }

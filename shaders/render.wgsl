@@ -20,7 +20,8 @@
 // and src/gpu/types.rs, declared again here so the renderer does not depend
 // on the step's bindings (tests/render.rs checks the two stay alike).
 struct BodyState {
-    pos: vec4<f32>,
+    pos: vec3<f32>,
+    rest_time: f32,
     disp: vec3<f32>,
     pos_low: u32,
     rot: vec4<f32>,
@@ -127,7 +128,7 @@ fn shade(albedo: vec3<f32>, n: vec3<f32>, world_pos: vec3<f32>) -> vec3<f32> {
 fn body_point(mesh_pos: vec3<f32>, b: RenderBody) -> vec3<f32> {
     let s = states[b.body];
     // the state's quaternion drifts from unit length by rounding only; renormalise anyway
-    return s.pos.xyz + quat_rotate(normalize(s.rot), mesh_pos * b.half_extents);
+    return s.pos + quat_rotate(normalize(s.rot), mesh_pos * b.half_extents);
 }
 
 // The bodies as the sun sees them: depth only, into the shadow map.
@@ -257,7 +258,7 @@ fn anchor_world(body: i32, anchor: vec3<f32>) -> vec3<f32> {
         return anchor;
     }
     let s = states[u32(body)];
-    return s.pos.xyz + quat_rotate(normalize(s.rot), anchor);
+    return s.pos + quat_rotate(normalize(s.rot), anchor);
 }
 
 // The centre a joint's line starts from: the body's, or the anchor for the world.
@@ -265,7 +266,7 @@ fn centre_of(body: i32, anchor: vec3<f32>) -> vec3<f32> {
     if body < 0 {
         return anchor;
     }
-    return states[u32(body)].pos.xyz;
+    return states[u32(body)].pos;
 }
 
 // Three segments per joint (instance), two vertices each: centre of A to

@@ -67,7 +67,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let vb0 = end_velocity_before(b);
     let va = end_velocity(a, ea);
     let vb = end_velocity(b, eb);
-    let threshold = max(2.0 * length(params.gravity.xyz) * params.dt, RESTITUTION_THRESHOLD);
+    let threshold = max(2.0 * length(params.gravity) * params.dt, RESTITUTION_THRESHOLD);
     let mu = combined_friction(ea, eb);
     let e = combined_restitution(ea, eb);
     // summed over the points: the velocity change asked of b (a gets the

@@ -142,9 +142,9 @@ fn add_joint(acc: ptr<function, Snap>, s: BodyState, p: BodyProps, j: JointRef) 
     if (j.partner != WORLD) {
         let o = state_in[j.partner];
         r_o = quat_rotate(o.rot, j.local_partner);
-        target_point = o.pos.xyz + r_o;
+        target_point = o.pos + r_o;
     }
-    let gap = target_point - (s.pos.xyz + r);
+    let gap = target_point - (s.pos + r);
     let dist = length(gap);
     if (dist < 1e-7) {
         return false;
@@ -196,7 +196,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // a snap moves the displacement with the pose: the velocity changes by
     // dx / h, as Verlet's moving x_n while x_(n-1) stays does
     let dx = acc.dx * params.relaxation;
-    s.pos = vec4<f32>(s.pos.xyz + dx, s.pos.w);
+    s.pos = s.pos + dx;
     s.disp = s.disp + dx;
     s.pos_low = (s.pos_low & ~HELD) | select(0u, HELD, pressed != 0u);
     s.rot = quat_add_rotation(s.rot, acc.dtheta * (params.relaxation * split));

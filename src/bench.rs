@@ -392,7 +392,7 @@ fn mean_height(bodies: impl Iterator<Item = f32>) -> f64 {
 // ---------------------------------------------------------------------------
 
 const COPY_WGSL: &str = r#"
-struct BodyState { pos: vec4<f32>, disp: vec3<f32>, pos_low: u32, rot: vec4<f32>, prev_rot: vec4<f32> }
+struct BodyState { pos: vec3<f32>, rest_time: f32, disp: vec3<f32>, pos_low: u32, rot: vec4<f32>, prev_rot: vec4<f32> }
 struct Count { n: u32 }
 @group(0) @binding(0) var<storage, read> src: array<BodyState>;
 @group(0) @binding(1) var<storage, read_write> dst: array<BodyState>;

@@ -529,7 +529,8 @@ impl World {
             let step_index = (self.step + k as u64).min(NO_FAULT as u64 - 1) as u32;
             for substep in 0..substeps {
                 let p = Params {
-                    gravity: [s.gravity[0], s.gravity[1], s.gravity[2], self.ground.unwrap_or(0.0)],
+                    gravity: s.gravity,
+                    ground_height: self.ground.unwrap_or(0.0),
                     dt: h,
                     dt_prev,
                     relaxation: s.relaxation,
@@ -829,7 +830,7 @@ fn finite_output(b: &BodyOutput) -> bool {
     b.position.iter().chain(&b.orientation).chain(&b.linear_velocity).chain(&b.angular_velocity).all(|v| v.is_finite())
 }
 
-fn dvec(v: [f32; 4]) -> DVec3 {
+fn dvec(v: [f32; 3]) -> DVec3 {
     DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
 }
 
@@ -867,7 +868,7 @@ pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> B
         orientation: s.rot,
         linear_velocity: v.as_vec3().to_array(),
         angular_velocity: w.as_vec3().to_array(),
-        asleep: s.pos[3] >= crate::scene::SLEEP_AFTER,
+        asleep: s.rest_time >= crate::scene::SLEEP_AFTER,
     }
 }
 
@@ -912,14 +913,14 @@ pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
     scene.joints.iter().map(|j| (anchor(j.bodies[0], j.anchors[0]) - anchor(j.bodies[1], j.anchors[1])).length() as f32).collect()
 }
 
-/// Every body's GPU record, the bodies kept out of the grid (marked LARGE in
+/// Every body's GPU record, the bodies kept out of the grid (`LARGE_BODY` in
 /// their records) and the grid for the rest.
 pub fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
     let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &scene.settings)).collect();
     let radii: Vec<f32> = props.iter().map(|p| p.half_extents[3]).collect();
     let (large, grid) = plan_grid(&radii);
     for &i in &large {
-        props[i as usize].kind[2] = LARGE;
+        props[i as usize].grid_class = LARGE_BODY;
     }
     (props, large, grid)
 }
@@ -934,8 +935,12 @@ pub fn body_props(b: &Body, settings: &Settings) -> BodyProps {
     BodyProps {
         half_extents: [half[0], half[1], half[2], b.bounding_radius()],
         inv_inertia: [ii[0], ii[1], ii[2], b.inverse_mass()],
-        material: [b.restitution.unwrap_or(settings.restitution), b.friction.unwrap_or(settings.friction), 0.0, 0.0],
-        kind: [shape, if b.fixed { FLAG_FIXED } else { 0 }, 0, 0],
+        restitution: b.restitution.unwrap_or(settings.restitution),
+        friction: b.friction.unwrap_or(settings.friction),
+        shape,
+        flags: if b.fixed { FLAG_FIXED } else { 0 },
+        grid_class: GRID_BODY,
+        ..Default::default()
     }
 }
 
@@ -960,13 +965,7 @@ pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
     let v3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
     let q4 = |q: DQuat| [q.x as f32, q.y as f32, q.z as f32, q.w as f32];
     let x = v3(x0);
-    BodyState {
-        pos: [x[0], x[1], x[2], 0.0],
-        disp: v3(disp),
-        pos_low: if b.fixed { HELD } else { 0 },
-        rot: q4(q0),
-        prev_rot: q4(prev_q),
-    }
+    BodyState { pos: x, rest_time: 0.0, disp: v3(disp), pos_low: if b.fixed { HELD } else { 0 }, rot: q4(q0), prev_rot: q4(prev_q) }
 }
 
 fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {

@@ -29,7 +29,7 @@ fn finite(s: &BodyState) -> bool {
 
 /// A state the host sees as sane: finite, near, not fast.
 fn sane(s: &BodyState, dt: f32) -> bool {
-    let p = common::v3([s.pos[0], s.pos[1], s.pos[2]]);
+    let p = common::v3(s.pos);
     finite(s) && p.length() < 1e3 && common::v3(s.disp).length() / dt < 100.0
 }
 

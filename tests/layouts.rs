@@ -32,13 +32,17 @@ macro_rules! check_layout {
 #[test]
 fn shared_structs_match_member_by_member() {
     let common = &format!("{}{}", shaders::COMMON, shaders::BINDINGS);
-    check_layout!(common, BodyState { pos, disp, pos_low, rot, prev_rot });
-    check_layout!(common, BodyProps { half_extents, inv_inertia, material, kind });
+    check_layout!(common, BodyState { pos, rest_time, disp, pos_low, rot, prev_rot });
+    check_layout!(
+        common,
+        BodyProps { half_extents, inv_inertia, restitution, friction, kept_inv_mass, _pad0, shape, flags, grid_class, _pad1 }
+    );
     check_layout!(common, Velocity { linear, angular });
     check_layout!(
         common,
         Params {
             gravity,
+            ground_height,
             dt,
             dt_prev,
             relaxation,
@@ -83,6 +87,8 @@ fn constants_match() {
     assert_eq!(find("SHAPE_BOX"), SHAPE_BOX);
     assert_eq!(find("SHAPE_SPHERE"), SHAPE_SPHERE);
     assert_eq!(find("FLAG_FIXED"), FLAG_FIXED);
+    assert_eq!(find("GRID_BODY"), GRID_BODY);
+    assert_eq!(find("LARGE_BODY"), LARGE_BODY);
     assert_eq!(find("WORKGROUP"), WORKGROUP);
     assert_eq!(find("MAX_POINTS"), MAX_POINTS);
     assert_eq!(find("NONE"), NONE);

@@ -41,7 +41,7 @@ fn placed(b: &Body, settings: &Settings) -> Placed {
         Shape::Box { half_extents } => ShapeKind::Box(Vec3::from(half_extents)),
         Shape::Sphere { radius } => ShapeKind::Sphere(radius),
     };
-    Placed { centre: Vec3::from_slice(&s.pos[..3]), rot: Quat::from_array(s.rot), shape }
+    Placed { centre: Vec3::from_array(s.pos), rot: Quat::from_array(s.rot), shape }
 }
 
 #[test]

@@ -323,7 +323,7 @@ fn render_structs_match_the_wgsl() {
     check_layout!(render::RenderBody, "RenderBody" { half_extents, body, color, shape });
     check_layout!(render::JointLine, "JointLine" { anchor_a, body_a, anchor_b, body_b });
     // the renderer's copy of the pose matches the step's
-    check_layout!(verlet::gpu::types::BodyState, "BodyState" { pos, disp, pos_low, rot, prev_rot });
+    check_layout!(verlet::gpu::types::BodyState, "BodyState" { pos, rest_time, disp, pos_low, rot, prev_rot });
 }
 
 #[test]

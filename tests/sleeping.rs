@@ -32,7 +32,7 @@ fn with_sleeping_off_no_body_sleeps() {
     scene.settings.sleeping = false;
     let Some(mut w) = world(&scene) else { return };
     w.step(180).unwrap();
-    assert!(w.read_raw().unwrap().iter().all(|s| s.pos[3] == 0.0), "seconds at rest were counted with sleeping off");
+    assert!(w.read_raw().unwrap().iter().all(|s| s.rest_time == 0.0), "seconds at rest were counted with sleeping off");
     assert!(!w.read_state().unwrap()[0].asleep);
 }
 

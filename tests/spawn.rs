@@ -12,10 +12,10 @@ fn bodies_spawned_into_a_running_pile_settle_with_the_rest() {
     let Some(mut w) = world(&scene) else { return };
     w.step(180).unwrap();
     let mut before = w.read_raw().unwrap();
-    assert!(before.iter().any(|s| s.pos[3] > 0.0), "no body at rest after 3 s");
+    assert!(before.iter().any(|s| s.rest_time > 0.0), "no body at rest after 3 s");
     // an edit wakes every body: its seconds at rest (pos.w) start again
     for s in &mut before {
-        s.pos[3] = 0.0;
+        s.rest_time = 0.0;
     }
     let spawned: Vec<_> = (0..10).map(|k| box_body([0.5; 3], [k as f32 * 1.2 - 6.0, 8.0, 0.3 * k as f32])).collect();
     let range = w.add_bodies(&spawned, &[]).unwrap();

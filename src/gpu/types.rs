@@ -8,8 +8,10 @@ use bytemuck::{Pod, Zeroable};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BodyState {
-    /// xyz = centre of mass (m); w = seconds at rest (see `asleep` in common.wgsl).
-    pub pos: [f32; 4],
+    /// Centre of mass (m).
+    pub pos: [f32; 3],
+    /// Seconds at rest (see `asleep` in common.wgsl).
+    pub rest_time: f32,
     /// x_n - x_(n-1): how far the centre moved over the last substep (m).
     /// Verlet's velocity is `disp / h`; kept instead of the previous position
     /// so that it is not the difference of two large numbers.
@@ -38,10 +40,18 @@ pub struct BodyProps {
     pub half_extents: [f32; 4],
     /// xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg).
     pub inv_inertia: [f32; 4],
-    /// x = restitution, y = friction.
-    pub material: [f32; 4],
-    /// x = shape (`SHAPE_BOX`, `SHAPE_SPHERE`), y = flags (`FLAG_FIXED`).
-    pub kind: [u32; 4],
+    pub restitution: f32,
+    pub friction: f32,
+    /// A body an input made fixed: the inverse mass to restore (1/kg); else 0.
+    pub kept_inv_mass: f32,
+    pub _pad0: f32,
+    /// `SHAPE_BOX` or `SHAPE_SPHERE`.
+    pub shape: u32,
+    /// `FLAG_*` bits.
+    pub flags: u32,
+    /// `GRID_BODY`, or `LARGE_BODY` (kept out of the broadphase grid).
+    pub grid_class: u32,
+    pub _pad1: u32,
 }
 
 /// Velocity after integration, before constraints (32 bytes).
@@ -56,8 +66,10 @@ pub struct Velocity {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Params {
-    /// xyz = gravity (m/s^2); w = ground height (m).
-    pub gravity: [f32; 4],
+    /// m/s^2.
+    pub gravity: [f32; 3],
+    /// m.
+    pub ground_height: f32,
     pub dt: f32,
     pub dt_prev: f32,
     pub relaxation: f32,
@@ -215,8 +227,10 @@ pub const SCAN_BLOCK: u32 = 256;
 pub const SHAPE_BOX: u32 = 0;
 pub const SHAPE_SPHERE: u32 = 1;
 pub const FLAG_FIXED: u32 = 1;
-/// `BodyProps::kind[2]` of a body too large for the grid.
-pub const LARGE: u32 = 1;
+/// `BodyProps::grid_class` of a body in the broadphase grid, and of one too
+/// large for it (`GRID_BODY`, `LARGE_BODY` in WGSL).
+pub const GRID_BODY: u32 = 0;
+pub const LARGE_BODY: u32 = 1;
 
 /// Threads per workgroup of every per-body pass (`WORKGROUP` in WGSL).
 pub const WORKGROUP: u32 = 64;

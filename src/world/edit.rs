@@ -68,12 +68,12 @@ impl World {
             if let Some(from) = *from {
                 states[k] = old_states[from];
                 // an edit wakes every body (see `asleep` in common.wgsl)
-                states[k].pos[3] = 0.0;
+                states[k].rest_time = 0.0;
                 // mass, material and the fixed flag as the user last set them;
                 // whether it sits in the grid is the new world's choice
-                let large = props[k].kind[2];
+                let grid_class = props[k].grid_class;
                 props[k] = old_props[from];
-                props[k].kind[2] = large;
+                props[k].grid_class = grid_class;
             }
         }
         let queue = &world.gpu.queue;

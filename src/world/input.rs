@@ -163,7 +163,10 @@ impl Wind {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct InputHeader {
-    pub gravity: [f32; 4],
+    /// settings.gravity (m/s^2).
+    pub gravity: [f32; 3],
+    /// h, the last substep (s).
+    pub substep_dt: f32,
     pub centre: [f32; 4],
     pub reach: [f32; 4],
     pub counts: [u32; 4],
@@ -327,7 +330,7 @@ impl World {
 
     fn input_header(&self, ops: usize) -> InputHeader {
         let g = self.settings.gravity;
-        InputHeader { gravity: [g[0], g[1], g[2], self.dt_prev], counts: [self.body_count, ops as u32, 0, 0], ..Default::default() }
+        InputHeader { gravity: g, substep_dt: self.dt_prev, counts: [self.body_count, ops as u32, 0, 0], ..Default::default() }
     }
 
     /// Validates `inputs` (naming bad ones after `list`, or plainly when it

@@ -158,11 +158,13 @@ impl Snapshot {
             .map(|i| {
                 let at = HEADER + i * POSE;
                 let v4 = |k: usize| -> [f32; 4] { std::array::from_fn(|c| f32_at(at + 16 * k + 4 * c)) };
-                let pos = v4(0);
+                let first = v4(0);
+                let (pos, rest_time) = ([first[0], first[1], first[2]], first[3]);
                 if version == VERSION_PREV_POS {
                     let prev = v4(1);
                     return BodyState {
                         pos,
+                        rest_time,
                         disp: std::array::from_fn(|c| pos[c] - prev[c]),
                         pos_low: if prev[3] > 0.0 { HELD } else { 0 },
                         rot: v4(2),
@@ -170,7 +172,14 @@ impl Snapshot {
                     };
                 }
                 let second = v4(1);
-                BodyState { pos, disp: [second[0], second[1], second[2]], pos_low: u32_at(at + 28), rot: v4(2), prev_rot: v4(3) }
+                BodyState {
+                    pos,
+                    rest_time,
+                    disp: [second[0], second[1], second[2]],
+                    pos_low: u32_at(at + 28),
+                    rot: v4(2),
+                    prev_rot: v4(3),
+                }
             })
             .collect();
         Ok(Snapshot { step, time, dt_prev, scene_hash, states })
