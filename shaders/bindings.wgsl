@@ -33,7 +33,7 @@
 // buffer is made); status[8..11]: the narrowphase's indirect dispatch
 // (workgroups over the pairs, 1, 1), copied out before it runs;
 // status[12..15]: the contact passes' (workgroups over the manifolds, 1, 1),
-// written by manifolds_dispatch and copied out after it; 16 words
+// written by contact_lists and copied out after it; 16 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1

@@ -88,7 +88,7 @@ struct Params {
     ground_friction: f32,    // the ground's material (settings.friction)
     cell_size: f32,          // edge of a broadphase grid cell (m)
     hash_size: u32,          // buckets of the grid's hash table (a power of two)
-    large_count: u32,        // bodies too large for the grid (see large[])
+    large_count: u32,        // bodies too large for the grid (see large_body())
     speculative: f32,        // farthest gap (m) at which grid pairs get contacts
     substeps: u32,           // substeps per step: contacts found once serve them all
     step_index: u32,         // the world's step count as this step began (saturates at NO_FAULT - 1)
