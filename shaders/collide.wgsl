@@ -177,61 +177,58 @@ const AXIS_FACE: u32 = 1u;
 const AXIS_EDGE: u32 = 2u;
 
 fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, margin: f32) -> BoxAxis {
-    var out = BoxAxis(AXIS_APART, vec3<f32>(0.0, 1.0, 0.0), 0u, 0u, 0u);
+    // Everything in a's frame: column j of r is b's axis j, t is b's centre.
+    // All 15 axes are tested without an early exit and without indexing an
+    // array: lanes packed into one vector run the same code whatever their
+    // pair, and most candidate pairs touch.
     let axes_a = box_axes(qa);
     let axes_b = box_axes(qb);
-    let d = cb - ca;
+    let ma = mat3x3<f32>(axes_a[0], axes_a[1], axes_a[2]);
+    let r = transpose(ma) * mat3x3<f32>(axes_b[0], axes_b[1], axes_b[2]);
+    let ar = mat3x3<f32>(abs(r[0]), abs(r[1]), abs(r[2]));
+    let t = (cb - ca) * ma;
 
-    // face axes of a (0..3) and b (3..6)
-    var best_face_sep = -3.4e38;
-    var best_face_n = vec3<f32>(0.0);
+    // face axes of a (0..3) and b (3..6): separation, signed offset along the axis
+    let sep_a = abs(t) - ha - ar * hb;
+    let s_b = t * r;
+    let sep_b = abs(s_b) - ha * ar - hb;
+    var worst = max(max(max(sep_a.x, sep_a.y), max(sep_a.z, sep_b.x)), max(sep_b.y, sep_b.z));
+    var best_face_sep = sep_a.x;
     var best_face = 0u;
-    for (var k = 0u; k < 6u; k = k + 1u) {
-        var axis: vec3<f32>;
-        if (k < 3u) {
-            axis = axes_a[k];
-        } else {
-            axis = axes_b[k - 3u];
-        }
-        let s = dot(d, axis);
-        let sep = abs(s) - project_box(axes_a, ha, axis) - project_box(axes_b, hb, axis);
-        if (sep > margin) {
-            return out;
-        }
-        if (sep > best_face_sep) {
-            best_face_sep = sep;
-            best_face_n = select(axis, -axis, s < 0.0);
-            best_face = k;
-        }
+    for (var k = 1u; k < 6u; k = k + 1u) {
+        let sep = select(sep_b[k - 3u], sep_a[min(k, 2u)], k < 3u);
+        best_face = select(best_face, k, sep > best_face_sep);
+        best_face_sep = max(best_face_sep, sep);
     }
-    // edge axes
+    let face_s = select(s_b[best_face % 3u], t[best_face % 3u], best_face < 3u);
+    let face_axis = select(axes_b[best_face % 3u], axes_a[best_face % 3u], best_face < 3u);
+    let best_face_n = select(face_axis, -face_axis, face_s < 0.0);
+
+    // edge axes a_i x b_j, in a's frame; near-parallel edges are left to
+    // the face axes
     var best_edge_sep = -3.4e38;
-    var best_edge_n = vec3<f32>(0.0);
-    var edge_i = 0u;
-    var edge_j = 0u;
-    for (var i = 0u; i < 3u; i = i + 1u) {
-        for (var j = 0u; j < 3u; j = j + 1u) {
-            let c = cross(axes_a[i], axes_b[j]);
-            let len = length(c);
-            if (len < 1e-5) {
-                continue;
-            }
-            let axis = c / len;
-            let s = dot(d, axis);
-            let sep = abs(s) - project_box(axes_a, ha, axis) - project_box(axes_b, hb, axis);
-            if (sep > margin) {
-                return out;
-            }
-            if (sep > best_edge_sep) {
-                best_edge_sep = sep;
-                best_edge_n = select(axis, -axis, s < 0.0);
-                edge_i = i;
-                edge_j = j;
-            }
-        }
+    var best_edge_l = vec3<f32>(0.0, 1.0, 0.0);
+    var best_edge = 0u;
+    for (var e = 0u; e < 9u; e = e + 1u) {
+        let i = e / 3u;
+        let bj = r[e % 3u];
+        let l = select(select(vec3<f32>(-bj.y, bj.x, 0.0), vec3<f32>(bj.z, 0.0, -bj.x), i == 1u),
+                       vec3<f32>(0.0, -bj.z, bj.y), i == 0u);
+        let len = length(l);
+        let s = dot(t, l);
+        let sep = (abs(s) - dot(ha, abs(l)) - dot(hb, abs(l * r))) / len;
+        let counts = len >= 1e-5;
+        worst = select(worst, max(worst, sep), counts);
+        let better = counts && sep > best_edge_sep;
+        best_edge_sep = select(best_edge_sep, sep, better);
+        best_edge_l = select(best_edge_l, select(l, -l, s < 0.0) / len, better);
+        best_edge = select(best_edge, e, better);
+    }
+    if (worst > margin) {
+        return BoxAxis(AXIS_APART, vec3<f32>(0.0, 1.0, 0.0), 0u, 0u, 0u);
     }
     if (best_edge_sep > best_face_sep + EDGE_BIAS) {
-        return BoxAxis(AXIS_EDGE, best_edge_n, 0u, edge_i, edge_j);
+        return BoxAxis(AXIS_EDGE, ma * best_edge_l, 0u, best_edge / 3u, best_edge % 3u);
     }
     return BoxAxis(AXIS_FACE, best_face_n, best_face, 0u, 0u);
 }

@@ -100,12 +100,10 @@ struct Params {
 }
 
 // A candidate pair found by the broadphase (pairs.wgsl): body a owns it; b
-// is another body or GROUND; `manifold` indexes the manifold pool, or NONE when the
-// narrowphase found no points. 12 bytes.
+// is another body or GROUND. 8 bytes.
 struct Pair {
     a: u32,
     b: u32,
-    manifold: u32,
 }
 
 // One contact point of a pair: the point on each body in that body's own
@@ -127,7 +125,7 @@ struct ContactManifold {
     a: u32,
     b: u32,
     clip_face: u32, // NONE, or the reference face narrowphase_clip still has to clip
-    _pad0: u32,
+    pair: u32,      // the candidate pair (index in `pairs`) it was found for
     points: array<ContactPoint, 4>,
 }
 

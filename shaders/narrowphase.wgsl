@@ -88,13 +88,14 @@ fn wake_check(sleeper: u32, other: u32, gap: f32) {
 // Stores manifold m of bodies a and b (b may be GROUND) in pool slot
 // `slot`, its points in the bodies' own frames, and wakes a sleeper that an
 // awake partner presses or hits.
-fn store_manifold(slot: u32, a: u32, b: u32, m: Manifold) {
+fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
     var stored: ContactManifold;
     stored.normal = m.normal;
     stored.count = m.count;
     stored.a = a;
     stored.b = b;
     stored.clip_face = NONE;
+    stored.pair = pair;
     var deepest = 3.4e38;
     for (var k = 0u; k < MAX_POINTS; k = k + 1u) {
         if (k < m.count) {
@@ -113,12 +114,30 @@ fn store_manifold(slot: u32, a: u32, b: u32, m: Manifold) {
     }
 }
 
-// A slot of the manifold pool, or NONE when the pool is full (counted in
-// status[4] all the same, so the host grows it).
-fn new_manifold() -> u32 {
+// A slot of the manifold pool for bodies a and b (b may be GROUND), listed
+// in both bodies' lists (in the order the slots are taken; contact_lists
+// sorts them), or NONE when the pool is full (counted in status[4] all the
+// same, so the host grows it).
+fn new_manifold(a: u32, b: u32) -> u32 {
     let slot = atomicAdd(&status[4], 1u);
     atomicMax(&status[5], slot + 1u);
-    return select(NONE, slot, slot < arrayLength(&manifolds));
+    if (slot >= arrayLength(&manifolds)) {
+        return NONE;
+    }
+    list_contact(a, contact_ref(slot, false));
+    if (b != GROUND) {
+        list_contact(b, contact_ref(slot, true));
+    }
+    return slot;
+}
+
+// Appends contact reference r to body i's list (which has room for all of
+// the body's pairs; the cursor counts from 0 after the pair scan).
+fn list_contact(i: u32, r: u32) {
+    let k = pair_meta[i].list_start + atomicAdd(&pair_meta[i].cursor, 1u);
+    if (k < arrayLength(&body_pairs)) {
+        body_pairs[k] = r;
+    }
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -132,9 +151,9 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (pr.b == GROUND) {
         let m = ground_manifold(pr.a, CONTACT_MARGIN + pair_meta[pr.a].reach);
         if (m.count > 0u) {
-            slot = new_manifold();
+            slot = new_manifold(pr.a, pr.b);
             if (slot != NONE) {
-                store_manifold(slot, pr.a, pr.b, m);
+                store_manifold(slot, pr.a, pr.b, p, m);
             }
         }
     } else {
@@ -146,10 +165,10 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
             // costly part, in narrowphase_clip over the face manifolds only
             let axis = box_box_axis(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
             if (axis.kind != AXIS_APART) {
-                slot = new_manifold();
+                slot = new_manifold(pr.a, pr.b);
             }
             if (slot != NONE && axis.kind == AXIS_EDGE) {
-                store_manifold(slot, pr.a, pr.b, box_box_edge(a.centre, a.rot, a.half, b.centre, b.rot, b.half, axis));
+                store_manifold(slot, pr.a, pr.b, p, box_box_edge(a.centre, a.rot, a.half, b.centre, b.rot, b.half, axis));
             } else if (slot != NONE) {
                 var pending: ContactManifold;
                 pending.normal = axis.normal;
@@ -157,19 +176,19 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
                 pending.a = pr.a;
                 pending.b = pr.b;
                 pending.clip_face = axis.face;
+                pending.pair = p;
                 manifolds[slot] = pending;
             }
         } else {
             let m = collide_with_sphere(a, b, margin);
             if (m.count > 0u) {
-                slot = new_manifold();
+                slot = new_manifold(pr.a, pr.b);
                 if (slot != NONE) {
-                    store_manifold(slot, pr.a, pr.b, m);
+                    store_manifold(slot, pr.a, pr.b, p, m);
                 }
             }
         }
     }
-    pairs[p].manifold = slot;
 }
 
 // Pass "narrowphase_clip", after contact_lists (which sizes its dispatch),
@@ -192,15 +211,18 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
     let a = shape_of(ia);
     let b = shape_of(ib);
     let m = box_box_face(a.centre, a.rot, a.half, b.centre, b.rot, b.half, manifolds[k].normal, face, pair_margin(ia, ib));
-    store_manifold(k, ia, ib, m);
+    store_manifold(k, ia, ib, manifolds[k].pair, m);
 }
 
 // Pass "contact_lists", once after the narrowphase, one invocation per body:
-// the body's pairs that have a manifold, in list order, become the first
-// entries of its list as contact references (contact_ref; the solve and
-// restitution walk only these), counted in pair_meta's `contacts`.
-// Invocation 0 also writes the contact passes' indirect dispatch, over the
-// manifolds the pool holds (status[12..15]).
+// sorts the contact references (contact_ref) the narrowphase listed for the
+// body (in the order the pool's slots were taken, which depends on thread
+// timing) into pair order: the pairs the body is in by the partner's walk,
+// by pair index, then the pairs it owns, in the order its walk found them.
+// The solve and restitution sum a body's manifolds in this order, the same
+// every run. The count goes to pair_meta's `contacts`. Invocation 0 also
+// writes the contact passes' indirect dispatch, over the manifolds the pool
+// holds (status[12..15]).
 @compute @workgroup_size(WORKGROUP)
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -214,18 +236,24 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let first = pair_meta[i].list_start;
-    let end = min(first + pair_meta[i].total, arrayLength(&body_pairs));
-    var out = first;
-    for (var e = first; e < end; e = e + 1u) {
-        let q = body_pairs[e];
-        if (q == NONE) {
-            continue;
+    let end = min(first + atomicLoad(&pair_meta[i].cursor), arrayLength(&body_pairs));
+    for (var k = first + 1u; k < end; k = k + 1u) {
+        let r = body_pairs[k];
+        let key = list_order(r);
+        var m = k;
+        while (m > first && list_order(body_pairs[m - 1u]) > key) {
+            body_pairs[m] = body_pairs[m - 1u];
+            m = m - 1u;
         }
-        let pr = pairs[q];
-        if (pr.manifold != NONE) {
-            body_pairs[out] = contact_ref(pr.manifold, pr.a != i);
-            out = out + 1u;
-        }
+        body_pairs[m] = r;
     }
-    pair_meta[i].contacts = out - first;
+    pair_meta[i].contacts = end - first;
+}
+
+// Where contact reference r goes in its body's list: pairs the body does not
+// own (it is end b) first, then owned ones, each by pair index (the owner
+// writes its pairs in walk order; a pair index stays below 2^31, see
+// world.rs's capacity).
+fn list_order(r: u32) -> u32 {
+    return manifolds[r >> 1u].pair | select(0x80000000u, 0u, (r & 1u) != 0u);
 }

@@ -2,17 +2,20 @@
 // in an order that does not depend on thread timing.
 //
 //   pairs_count   bodies: walk the body's own grid cell and the 13 cells
-//                 ahead of it, and the large bodies; count the pairs it owns, and count each into its
-//                 partner's incoming pairs (pair_meta's cursor, an integer
-//                 atomic: the sum does not depend on the order)
+//                 ahead of it, and the large bodies; count the pairs it
+//                 owns, and count each into its partner's incoming pairs
+//                 (pair_meta's cursor, an integer atomic: the sum does not
+//                 depend on the order)
 //   scan_*        (grid.wgsl, SCAN_PAIRS) prefix sums of the owned and of all
-//                 pairs, the narrowphase's indirect dispatch; the cursors
+//                 pairs (where each body's pairs and its contact list
+//                 start), the narrowphase's indirect dispatch; the cursors
 //                 start again from 0
 //   pairs_write   bodies: walk again; write the owned pairs at the body's
-//                 offset, list each in both bodies' pair lists (an owned
-//                 pair at its rank, an incoming one by the partner's cursor)
-//   pairs_sort    bodies: sort the incoming part of the body's list by pair
-//                 index (the cursor's order depends on thread timing)
+//                 offset, in the order the walk finds them
+//
+// A body's list (body_pairs from list_start, room for all its pairs) is
+// filled later, by the narrowphase, with the pairs that have a manifold,
+// and sorted by contact_lists (narrowphase.wgsl).
 //
 // Who owns a pair (see `walk`): of two grid bodies in neighbouring cells,
 // the one whose cell is behind the other's (the other's cell is among its
@@ -21,9 +24,7 @@
 // index. A grid body owns its pairs with every large body (it always walks
 // them all); a large body (kept out of the grid) owns only its pairs with
 // large bodies of higher index, so it never walks the cells; every body
-// owns its pair with the ground. A body's list is its incoming pairs sorted by pair index,
-// then its owned ones in the order its walk found them: the solve sums in
-// that order, the same every run. A pair is wanted when the two bodies'
+// owns its pair with the ground. A pair is wanted when the two bodies'
 // bounds come within the margin, they are not joined, and one of them
 // moves: not fixed and awake, or asleep but woken by the last step's
 // narrowphase. Only the owner decides, alike in both walks (the test reads
@@ -93,28 +94,11 @@ var<private> walker: Walker;
 var<private> writing: bool;
 var<private> owned: u32;
 
-// Lists owned pair number `owned` of the walker: (a, b) = (walker, j).
+// Writes owned pair number `owned` of the walker: (a, b) = (walker, j).
 fn write_owned(j: u32) {
-    let i = walker.index;
-    let owned_start = pair_meta[i].owned_start;
-    let p = owned_start + owned;
-    let list_incoming = pair_meta[i].total - pair_meta[i].owned;
-    var entry = NONE;
+    let p = pair_meta[walker.index].owned_start + owned;
     if (p < arrayLength(&pairs)) {
-        pairs[p] = Pair(i, j, NONE);
-        entry = p;
-    }
-    list_put(pair_meta[i].list_start + list_incoming + owned, entry);
-    if (j != GROUND) {
-        list_put(pair_meta[j].list_start + atomicAdd(&pair_meta[j].cursor, 1u), entry);
-    }
-}
-
-// A pair list entry, unless the lists are full (the pairs are then reported
-// too many; see status[0]).
-fn list_put(k: u32, entry: u32) {
-    if (k < arrayLength(&body_pairs)) {
-        body_pairs[k] = entry;
+        pairs[p] = Pair(walker.index, j);
     }
 }
 
@@ -126,7 +110,7 @@ fn visit(j: u32, pos_j: vec3<f32>) {
     if (writing) {
         write_owned(j);
     } else {
-        atomicAdd(&pair_meta[j].cursor, 1u);
+        atomicAdd(&pair_meta[j].cursor, 1u); // one more incoming pair of j
     }
     owned = owned + 1u;
 }
@@ -201,23 +185,4 @@ fn pairs_write(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     writing = true;
     walk(sorted[gid.x]);
-}
-
-@compute @workgroup_size(WORKGROUP)
-fn pairs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= params.body_count) {
-        return;
-    }
-    let start = pair_meta[i].list_start;
-    let end = min(start + atomicLoad(&pair_meta[i].cursor), arrayLength(&body_pairs));
-    for (var k = start + 1u; k < end; k = k + 1u) {
-        let v = body_pairs[k];
-        var m = k;
-        while (m > start && body_pairs[m - 1u] > v) {
-            body_pairs[m] = body_pairs[m - 1u];
-            m = m - 1u;
-        }
-        body_pairs[m] = v;
-    }
 }

@@ -32,7 +32,6 @@ pub const PASSES: &[(&str, &str, &[&str])] = &[
     ("pairs_scan_sums", "scan_sums", GRID_PASS),
     ("pairs_scan_add", "scan_add", GRID_PASS),
     ("pairs_write", "pairs_write", PAIRS_PASS),
-    ("pairs_sort", "pairs_sort", PAIRS_PASS),
     ("narrowphase", "narrowphase", NARROWPHASE_PASS),
     ("contact_lists", "contact_lists", NARROWPHASE_PASS),
     ("narrowphase_clip", "narrowphase_clip", NARROWPHASE_PASS),

@@ -104,7 +104,7 @@ pub struct Params {
     pub _pad5: u32,
 }
 
-/// A candidate pair (12 bytes); see `Pair` in common.wgsl.
+/// A candidate pair (8 bytes); see `Pair` in common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Pair {
@@ -112,8 +112,6 @@ pub struct Pair {
     pub a: u32,
     /// Another body, or `GROUND`.
     pub b: u32,
-    /// Index into the manifold pool, or `NONE`.
-    pub manifold: u32,
 }
 
 /// One contact point of a pair's manifold (32 bytes).
@@ -141,7 +139,8 @@ pub struct ContactManifold {
     pub b: u32,
     /// `NONE`, or the face the narrowphase left to clip (within a step).
     pub clip_face: u32,
-    pub _pad0: u32,
+    /// The candidate pair (index into the pair list) it was found for.
+    pub pair: u32,
     pub points: [ContactPoint; 4],
 }
 

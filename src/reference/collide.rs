@@ -118,44 +118,47 @@ pub fn box_box(ca: Vec3, qa: Quat, ha: Vec3, cb: Vec3, qb: Quat, hb: Vec3, margi
     let axes_a = [ra.x_axis, ra.y_axis, ra.z_axis];
     let axes_b = [rb.x_axis, rb.y_axis, rb.z_axis];
     let d = cb - ca;
-    let proj =
-        |axes: &[Vec3; 3], h: Vec3, l: Vec3| h.x * axes[0].dot(l).abs() + h.y * axes[1].dot(l).abs() + h.z * axes[2].dot(l).abs();
-    // separation along an axis (unit), and the axis turned to point from a to b
-    let test = |l: Vec3| {
-        let s = d.dot(l);
-        let sep = s.abs() - proj(&axes_a, ha, l) - proj(&axes_b, hb, l);
-        (sep, if s < 0.0 { -l } else { l })
-    };
+    // everything in a's frame: column j of r is b's axis j, t is b's centre
+    let r = ra.transpose() * rb;
+    let ar = Mat3::from_cols(r.x_axis.abs(), r.y_axis.abs(), r.z_axis.abs());
+    let t = ra.transpose() * d;
 
-    // face axes of a (0..3) and b (3..6)
-    let mut best_face = (f32::MIN, Vec3::ZERO, 0usize);
-    for k in 0..6 {
-        let axis = if k < 3 { axes_a[k] } else { axes_b[k - 3] };
-        let (sep, l) = test(axis);
-        if sep > margin {
-            return None;
-        }
+    // face axes of a (0..3) and b (3..6): separation, signed offset along the axis
+    let sep_a = t.abs() - ha - ar * hb;
+    let s_b = r.transpose() * t;
+    let sep_b = s_b.abs() - ar.transpose() * ha - hb;
+    let mut best_face = (sep_a.x, 0usize);
+    for k in 1..6 {
+        let sep = if k < 3 { sep_a[k] } else { sep_b[k - 3] };
         if sep > best_face.0 {
-            best_face = (sep, l, k);
+            best_face = (sep, k);
         }
     }
-    // edge axes
+    let mut worst = sep_a.max_element().max(sep_b.max_element());
+    let face_k = best_face.1;
+    let (face_s, face_axis) = if face_k < 3 { (t[face_k], axes_a[face_k]) } else { (s_b[face_k - 3], axes_b[face_k - 3]) };
+    let best_face = (best_face.0, if face_s < 0.0 { -face_axis } else { face_axis }, face_k);
+
+    // edge axes a_i x b_j, in a's frame; near-parallel edges are left to the face axes
     let mut best_edge = (f32::MIN, Vec3::ZERO, 0usize, 0usize);
     for i in 0..3 {
         for j in 0..3 {
-            let c = axes_a[i].cross(axes_b[j]);
-            let len = c.length();
+            let bj = r.col(j);
+            let l = Vec3::AXES[i].cross(bj);
+            let len = l.length();
             if len < 1e-5 {
-                continue; // parallel edges: the face axes cover it
+                continue;
             }
-            let (sep, l) = test(c / len);
-            if sep > margin {
-                return None;
-            }
+            let s = t.dot(l);
+            let sep = (s.abs() - ha.dot(l.abs()) - hb.dot((r.transpose() * l).abs())) / len;
+            worst = worst.max(sep);
             if sep > best_edge.0 {
-                best_edge = (sep, l, i, j);
+                best_edge = (sep, ra * (if s < 0.0 { -l } else { l } / len), i, j);
             }
         }
+    }
+    if worst > margin {
+        return None;
     }
 
     if best_edge.0 > best_face.0 + EDGE_BIAS {

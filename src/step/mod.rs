@@ -35,7 +35,6 @@ pub enum Stage {
     PairsScanSums,
     PairsScanAdd,
     PairsWrite,
-    PairsSort,
     Narrowphase,
     ContactLists,
     NarrowphaseClip,
@@ -66,7 +65,7 @@ pub enum Over {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 21] = [
+    pub const ALL: [Stage; 20] = [
         Stage::GridClear,
         Stage::GridCount,
         Stage::GridScanBlocks,
@@ -79,7 +78,6 @@ impl Stage {
         Stage::PairsScanSums,
         Stage::PairsScanAdd,
         Stage::PairsWrite,
-        Stage::PairsSort,
         Stage::Narrowphase,
         Stage::ContactLists,
         Stage::NarrowphaseClip,
@@ -106,7 +104,6 @@ impl Stage {
             Stage::PairsScanSums => "pairs_scan_sums",
             Stage::PairsScanAdd => "pairs_scan_add",
             Stage::PairsWrite => "pairs_write",
-            Stage::PairsSort => "pairs_sort",
             Stage::Narrowphase => "narrowphase",
             Stage::ContactLists => "contact_lists",
             Stage::NarrowphaseClip => "narrowphase_clip",
