@@ -146,7 +146,7 @@ fn clip_poly(src: ptr<private, array<vec3<f32>, 8>>, len: u32, dst: ptr<private,
     var out_len = 0u;
     for (var i = 0u; i < len; i = i + 1u) {
         let p = (*src)[i];
-        let q = (*src)[(i + 1u) % len];
+        let q = (*src)[select(i + 1u, 0u, i + 1u == len)];
         let dp = dot(p, n) - offset;
         let dq = dot(q, n) - offset;
         if (dp <= 0.0 && out_len < 8u) {
@@ -159,6 +159,11 @@ fn clip_poly(src: ptr<private, array<vec3<f32>, 8>>, len: u32, dst: ptr<private,
         }
     }
     return out_len;
+}
+
+// Column k of m.
+fn column(m: mat3x3<f32>, k: u32) -> vec3<f32> {
+    return select(select(m[2], m[1], k == 1u), m[0], k == 0u);
 }
 
 // The separating-axis test of two boxes within `margin`: the axis of
@@ -265,46 +270,37 @@ fn box_box_edge(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
 // The manifold of a face contact (an AXIS_FACE of normal n, reference face
 // best_face): the incident face of the other box clipped against the
 // reference face's sides, its points within the margin, reduced to four.
+// Only the clipped polygon is an array; a kept point's two ends are
+// recomputed from it where needed (face_point), and the reduction keeps
+// indices into it.
 fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>,
                 n: vec3<f32>, best_face: u32, margin: f32) -> Manifold {
     var m = empty_manifold();
     let axes_a = box_axes(qa);
     let axes_b = box_axes(qb);
-    // reference box owns the face; n_ref points from it to the incident box
+    // reference box owns the face; ref_n points from it to the incident box
     let flipped = best_face >= 3u;
     let face = best_face % 3u;
-    var ref_c = ca;
-    var ref_axes = axes_a;
-    var ref_h = ha;
-    var inc_c = cb;
-    var inc_axes = axes_b;
-    var inc_h = hb;
-    var ref_n = n;
-    if (flipped) {
-        ref_c = cb;
-        ref_axes = axes_b;
-        ref_h = hb;
-        inc_c = ca;
-        inc_axes = axes_a;
-        inc_h = ha;
-        ref_n = -n;
-    }
-    // incident face: the face of the incident box most anti-parallel to ref_n
-    var inc_face = 0u;
-    var most = 3.4e38;
-    for (var k = 0u; k < 3u; k = k + 1u) {
-        let v = -abs(dot(inc_axes[k], ref_n));
-        if (v < most) {
-            most = v;
-            inc_face = k;
-        }
-    }
-    let inc_sign = -sign_of(dot(inc_axes[inc_face], ref_n));
-    let inc_centre = inc_c + inc_axes[inc_face] * (inc_h[inc_face] * inc_sign);
+    let ref_c = select(ca, cb, flipped);
+    let ref_h = select(ha, hb, flipped);
+    let ref_axes = mat3x3<f32>(select(axes_a[0], axes_b[0], flipped), select(axes_a[1], axes_b[1], flipped),
+                               select(axes_a[2], axes_b[2], flipped));
+    let inc_c = select(cb, ca, flipped);
+    let inc_h = select(hb, ha, flipped);
+    let inc_axes = mat3x3<f32>(select(axes_b[0], axes_a[0], flipped), select(axes_b[1], axes_a[1], flipped),
+                               select(axes_b[2], axes_a[2], flipped));
+    let ref_n = select(n, -n, flipped);
+    // incident face: the face of the incident box most anti-parallel to
+    // ref_n (the first of equals)
+    let along = vec3<f32>(abs(dot(inc_axes[0], ref_n)), abs(dot(inc_axes[1], ref_n)), abs(dot(inc_axes[2], ref_n)));
+    let inc_face = select(select(2u, 1u, along.y >= along.z), 0u, along.x >= along.y && along.x >= along.z);
+    let inc_axis = column(inc_axes, inc_face);
+    let inc_sign = -sign_of(dot(inc_axis, ref_n));
+    let inc_centre = inc_c + inc_axis * (inc_h[inc_face] * inc_sign);
     let u = (inc_face + 1u) % 3u;
     let v = (inc_face + 2u) % 3u;
-    let eu = inc_axes[u] * inc_h[u];
-    let ev = inc_axes[v] * inc_h[v];
+    let eu = column(inc_axes, u) * inc_h[u];
+    let ev = column(inc_axes, v) * inc_h[v];
     poly_a[0] = inc_centre + eu + ev;
     poly_a[1] = inc_centre - eu + ev;
     poly_a[2] = inc_centre - eu - ev;
@@ -315,96 +311,103 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let ref_centre = ref_c + ref_n * ref_h[face];
     let side_u = (face + 1u) % 3u;
     let side_v = (face + 2u) % 3u;
-    let u_n = ref_axes[side_u];
-    let v_n = ref_axes[side_v];
-    var poly_len = clip_poly(&poly_a, 4u, &poly_b, u_n, dot(u_n, ref_c) + ref_h[side_u]);
-    poly_len = clip_poly(&poly_b, poly_len, &poly_a, -u_n, dot(-u_n, ref_c) + ref_h[side_u]);
-    poly_len = clip_poly(&poly_a, poly_len, &poly_b, v_n, dot(v_n, ref_c) + ref_h[side_v]);
-    poly_len = clip_poly(&poly_b, poly_len, &poly_a, -v_n, dot(-v_n, ref_c) + ref_h[side_v]);
-    // keep points within the margin of the reference face
-    var pts_a: array<vec3<f32>, 8>;
-    var pts_b: array<vec3<f32>, 8>;
+    let u_n = column(ref_axes, side_u);
+    let v_n = column(ref_axes, side_v);
+    var len = clip_poly(&poly_a, 4u, &poly_b, u_n, dot(u_n, ref_c) + ref_h[side_u]);
+    len = clip_poly(&poly_b, len, &poly_a, -u_n, dot(-u_n, ref_c) + ref_h[side_u]);
+    len = clip_poly(&poly_a, len, &poly_b, v_n, dot(v_n, ref_c) + ref_h[side_v]);
+    len = clip_poly(&poly_b, len, &poly_a, -v_n, dot(-v_n, ref_c) + ref_h[side_v]);
+
+    // the points within the margin of the reference face (`kept`), reduced
+    // to four: the deepest, the farthest from it, the largest triangle, the
+    // largest area added outside that triangle (the first of equals each)
     var count = 0u;
-    for (var k = 0u; k < poly_len; k = k + 1u) {
-        let p = poly_a[k];
-        let sep = dot(p - ref_centre, ref_n);
-        if (sep <= margin) {
-            let on_ref = p - ref_n * sep;
-            if (flipped) {
-                pts_a[count] = p;
-                pts_b[count] = on_ref;
-            } else {
-                pts_a[count] = on_ref;
-                pts_b[count] = p;
-            }
-            count = count + 1u;
+    var c0 = 0u;
+    var deepest = 3.4e38;
+    for (var k = 0u; k < len; k = k + 1u) {
+        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
+        let sep = dot(f.on_b - f.on_a, n);
+        if (f.kept && sep < deepest) {
+            deepest = sep;
+            c0 = k;
         }
+        count = count + u32(f.kept);
     }
     m.normal = n;
     if (count <= MAX_POINTS) {
-        m.count = count;
-        for (var k = 0u; k < count; k = k + 1u) {
-            m.on_a[k] = pts_a[k];
-            m.on_b[k] = pts_b[k];
+        for (var k = 0u; k < len; k = k + 1u) {
+            let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
+            if (f.kept) {
+                m.on_a[m.count] = f.on_a;
+                m.on_b[m.count] = f.on_b;
+                m.count = m.count + 1u;
+            }
         }
         return m;
     }
-    // reduce to four: the deepest, the farthest from it, the largest
-    // triangle, the largest area added outside that triangle
-    var chosen = array<u32, 4>(0u, 0u, 0u, 0u);
-    for (var k = 0u; k < count; k = k + 1u) {
-        if (dot(pts_b[k] - pts_a[k], n) < dot(pts_b[chosen[0]] - pts_a[chosen[0]], n)) {
-            chosen[0] = k;
-        }
-    }
-    let p0 = pts_b[chosen[0]];
+    let p0 = face_point(poly_a[c0], ref_centre, ref_n, flipped, margin).on_b;
+    var c1 = c0;
     var best = -1.0;
-    for (var k = 0u; k < count; k = k + 1u) {
-        let dd = dot(pts_b[k] - p0, pts_b[k] - p0);
-        if (dd > best) {
+    for (var k = 0u; k < len; k = k + 1u) {
+        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
+        let dd = dot(f.on_b - p0, f.on_b - p0);
+        if (f.kept && dd > best) {
             best = dd;
-            chosen[1] = k;
+            c1 = k;
         }
     }
-    let p1 = pts_b[chosen[1]];
+    let p1 = face_point(poly_a[c1], ref_centre, ref_n, flipped, margin).on_b;
+    var c2 = c0;
     best = -3.4e38;
-    for (var k = 0u; k < count; k = k + 1u) {
-        let area = abs(dot(cross(p1 - p0, pts_b[k] - p0), n));
-        if (area > best) {
+    for (var k = 0u; k < len; k = k + 1u) {
+        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
+        let area = abs(dot(cross(p1 - p0, f.on_b - p0), n));
+        if (f.kept && area > best) {
             best = area;
-            chosen[2] = k;
+            c2 = k;
         }
     }
-    let p2 = pts_b[chosen[2]];
+    let p2 = face_point(poly_a[c2], ref_centre, ref_n, flipped, margin).on_b;
     let side = sign_of(dot(cross(p1 - p0, p2 - p0), n));
+    var c3 = c0;
     best = -3.4e38;
-    chosen[3] = chosen[0];
-    for (var k = 0u; k < count; k = k + 1u) {
-        let q = pts_b[k];
+    for (var k = 0u; k < len; k = k + 1u) {
+        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
+        let q = f.on_b;
         let added = max(max(-side * dot(cross(p1 - p0, q - p0), n), -side * dot(cross(p2 - p1, q - p1), n)),
                         -side * dot(cross(p0 - p2, q - p2), n));
-        if (added > best) {
+        if (f.kept && added > best) {
             best = added;
-            chosen[3] = k;
+            c3 = k;
         }
     }
     // distinct choices only, in the order chosen
-    var out = 0u;
-    for (var c = 0u; c < 4u; c = c + 1u) {
-        var seen = false;
-        for (var e = 0u; e < c; e = e + 1u) {
-            if (chosen[e] == chosen[c]) {
-                seen = true;
-            }
-        }
+    for (var e = 0u; e < 4u; e = e + 1u) {
+        let k = select(select(select(c3, c2, e == 2u), c1, e == 1u), c0, e == 0u);
+        let seen = (e > 0u && k == c0) || (e > 1u && k == c1) || (e > 2u && k == c2);
         if (!seen) {
-            m.on_a[out] = pts_a[chosen[c]];
-            m.on_b[out] = pts_b[chosen[c]];
-            out = out + 1u;
+            let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
+            m.on_a[m.count] = f.on_a;
+            m.on_b[m.count] = f.on_b;
+            m.count = m.count + 1u;
         }
     }
-    m.count = out;
     return m;
+}
+
+// A clipped point p of the incident face as a contact point: its two ends
+// (p and its projection on the reference face, in the order of the pair),
+// and whether it lies within the margin of the face.
+struct FacePoint {
+    on_a: vec3<f32>,
+    on_b: vec3<f32>,
+    kept: bool,
+}
+
+fn face_point(p: vec3<f32>, ref_centre: vec3<f32>, ref_n: vec3<f32>, flipped: bool, margin: f32) -> FacePoint {
+    let sep = dot(p - ref_centre, ref_n);
+    let on_ref = p - ref_n * sep;
+    return FacePoint(select(on_ref, p, flipped), select(p, on_ref, flipped), sep <= margin);
 }
 
 // The manifold of a pair of which at least one is a sphere.
