@@ -10,8 +10,11 @@
 //                 pairs (where each body's pairs and its contact list
 //                 start), the narrowphase's indirect dispatch; the cursors
 //                 start again from 0
-//   pairs_write   bodies: walk again; write the owned pairs at the body's
-//                 offset, in the order the walk finds them
+//                 and note each partner in the body's scratch room (a
+//                 run of body_pairs by grid order, before the lists fill it)
+//   pairs_write   bodies: copy the owned pairs from the scratch room to the
+//                 body's offset, in the order the walk found them (a body
+//                 that owns more than its room holds walks again)
 //
 // A body's list (body_pairs from list_start, room for all its pairs) is
 // filled later, by the narrowphase, with the pairs that have a manifold,
@@ -89,10 +92,26 @@ struct Walker {
 }
 
 // The walk's state: who walks, whether it writes (pairs_write) or counts
-// (pairs_count), and how many pairs it found so far.
+// (pairs_count), where its scratch room starts, and how many pairs it found
+// so far.
 var<private> walker: Walker;
 var<private> writing: bool;
+var<private> room_start: u32;
 var<private> owned: u32;
+
+// Partners each body's scratch room holds: body_pairs shared out by grid
+// order (the lists have room for every pair twice, so at least twice the
+// mean per body).
+fn scratch_room() -> u32 {
+    return arrayLength(&body_pairs) / max(params.body_count, 1u);
+}
+
+// Notes partner j of owned pair number `owned` in the walker's room.
+fn note_owned(j: u32) {
+    if (owned < scratch_room()) {
+        body_pairs[room_start + owned] = j;
+    }
+}
 
 // Writes owned pair number `owned` of the walker: (a, b) = (walker, j).
 fn write_owned(j: u32) {
@@ -111,6 +130,7 @@ fn visit(j: u32, pos_j: vec3<f32>) {
         write_owned(j);
     } else {
         atomicAdd(&pair_meta[j].cursor, 1u); // one more incoming pair of j
+        note_owned(j);
     }
     owned = owned + 1u;
 }
@@ -138,6 +158,8 @@ fn walk(i: u32) {
     if (wants_ground(i)) {
         if (writing) {
             write_owned(GROUND);
+        } else {
+            note_owned(GROUND);
         }
         owned = owned + 1u;
     }
@@ -174,6 +196,7 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let i = sorted[gid.x];
     writing = false;
+    room_start = gid.x * scratch_room();
     walk(i);
     pair_meta[i].owned = owned;
 }
@@ -183,6 +206,18 @@ fn pairs_write(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.body_count) {
         return;
     }
-    writing = true;
-    walk(sorted[gid.x]);
+    let i = sorted[gid.x];
+    let count = pair_meta[i].owned;
+    if (count > scratch_room()) {
+        writing = true;
+        walk(i);
+        return;
+    }
+    let start = gid.x * scratch_room();
+    let first = pair_meta[i].owned_start;
+    for (var k = 0u; k < count; k = k + 1u) {
+        if (first + k < arrayLength(&pairs)) {
+            pairs[first + k] = Pair(i, body_pairs[start + k]);
+        }
+    }
 }

@@ -83,3 +83,43 @@ fn the_pair_pools_grow_for_a_crowded_scene() {
         }
     }
 }
+
+#[test]
+fn a_body_that_owns_more_pairs_than_its_scratch_room_lists_them_all() {
+    // a ball ringed by 30 small balls, all in one grid cell and all of higher
+    // index, so it owns every pair: more than the room pairs_count notes
+    // partners in (twice the pair list over the bodies, 12 here), so
+    // pairs_write walks again for it. Far balls, apart, make the ringed ball
+    // a median one (a grid body, not a large one) and the cells big enough.
+    let mut scene = scenes::stack(0);
+    scene.ground = None;
+    scene.settings.gravity = [0.0; 3];
+    let centre = Vec3::splat(0.5);
+    scene.bodies.push(sphere_body(0.42, centre.to_array()));
+    let ring = 30;
+    for k in 0..ring {
+        // Fibonacci points on a sphere: the small balls stay apart
+        let y = 1.0 - 2.0 * (k as f32 + 0.5) / ring as f32;
+        let phi = k as f32 * 2.399_963;
+        let dir = Vec3::new((1.0 - y * y).sqrt() * phi.cos(), y, (1.0 - y * y).sqrt() * phi.sin());
+        scene.bodies.push(sphere_body(0.04, (centre + dir * 0.45).to_array()));
+    }
+    for k in 0..40 {
+        scene.bodies.push(sphere_body(0.3, [10.0 + 2.0 * k as f32, 0.5, 0.5]));
+    }
+    let Some(mut w) = common::world(&scene) else { return };
+    let made = w.contact_report().unwrap();
+    assert!(2 * made.pair_capacity / (scene.bodies.len() as u32) < ring as u32, "the room holds every pair: {made:?}");
+    w.step(1).unwrap();
+    let report = w.contact_report().unwrap();
+    eprintln!("made {made:?}\nafter one step {report:?}");
+    assert_eq!(report.pairs, ring as u32, "candidate pairs: {report:?}");
+    assert!(!report.overflowed(), "{report:?}");
+    let contacts = w.read_contacts().unwrap();
+    let mut partners: Vec<u32> = contacts[0].iter().map(|c| c.partner).collect();
+    partners.dedup();
+    assert_eq!(partners, (1..=ring as u32).collect::<Vec<_>>(), "the ringed ball's contacts");
+    for (k, list) in contacts.iter().enumerate().skip(1).take(ring) {
+        assert!(!list.is_empty() && list.iter().all(|c| c.partner == 0), "small ball {k}: {list:?}");
+    }
+}
