@@ -26,7 +26,9 @@
 @group(0) @binding(16) var<storage, read_write> body_pairs: array<u32>;         // 2 x pair capacity
 // status[0]: candidate pairs wanted this step, status[1]: most in any step;
 // status[4]: manifolds used this step, status[5]: most in any step (a pool
-// too small when either exceeds its capacity); status[2], status[3]: the
+// too small when either exceeds its capacity); status[6]: of them, the face
+// contacts left for narrowphase_clip (taken from the top of the pool),
+// status[7]: the others (taken from the bottom); status[2], status[3]: the
 // first numerical fault (see integrate.wgsl): 4 * body + FAULT_* of the
 // lowest body found bad in the first step that found any, and that step's
 // step_index, both atomicMin-ed from NO_FAULT (0xffffffff, written when the
@@ -47,4 +49,13 @@ fn large_body(k: u32) -> u32 {
 // The manifolds this step's narrowphase stored (status[4], within the pool).
 fn manifolds_used() -> u32 {
     return min(atomicLoad(&status[4]), arrayLength(&manifolds));
+}
+
+// The slot of the k-th stored manifold (k < manifolds_used()): the pool
+// fills from both ends (see new_manifold in narrowphase.wgsl), the face
+// contacts left for clipping at the top.
+fn pool_slot(k: u32) -> u32 {
+    let top = min(atomicLoad(&status[6]), arrayLength(&manifolds));
+    let bottom = manifolds_used() - top;
+    return select(k, arrayLength(&manifolds) - top + (k - bottom), k >= bottom);
 }

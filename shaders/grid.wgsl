@@ -39,7 +39,10 @@ fn grid_clear(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&cell_count[gid.x], 0u);
     }
     if (gid.x == 0u) {
-        atomicStore(&status[4], 0u); // the manifold pool fills anew
+        // the manifold pool fills anew
+        atomicStore(&status[4], 0u);
+        atomicStore(&status[6], 0u);
+        atomicStore(&status[7], 0u);
     }
 }
 

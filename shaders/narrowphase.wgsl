@@ -117,12 +117,21 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
 // A slot of the manifold pool for bodies a and b (b may be GROUND), listed
 // in both bodies' lists (in the order the slots are taken; contact_lists
 // sorts them), or NONE when the pool is full (counted in status[4] all the
-// same, so the host grows it).
-fn new_manifold(a: u32, b: u32) -> u32 {
-    let slot = atomicAdd(&status[4], 1u);
-    atomicMax(&status[5], slot + 1u);
-    if (slot >= arrayLength(&manifolds)) {
+// same, so the host grows it). A face contact left for clipping (`to_clip`)
+// takes the next slot from the top of the pool, any other the next from the
+// bottom, so narrowphase_clip runs over the top run alone; the two never
+// meet, as status[4] hands out no more tickets than the pool has slots.
+fn new_manifold(a: u32, b: u32, to_clip: bool) -> u32 {
+    let ticket = atomicAdd(&status[4], 1u);
+    atomicMax(&status[5], ticket + 1u);
+    if (ticket >= arrayLength(&manifolds)) {
         return NONE;
+    }
+    var slot: u32;
+    if (to_clip) {
+        slot = arrayLength(&manifolds) - 1u - atomicAdd(&status[6], 1u);
+    } else {
+        slot = atomicAdd(&status[7], 1u);
     }
     list_contact(a, contact_ref(slot, false));
     if (b != GROUND) {
@@ -151,7 +160,7 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (pr.b == GROUND) {
         let m = ground_manifold(pr.a, CONTACT_MARGIN + pair_meta[pr.a].reach);
         if (m.count > 0u) {
-            slot = new_manifold(pr.a, pr.b);
+            slot = new_manifold(pr.a, pr.b, false);
             if (slot != NONE) {
                 store_manifold(slot, pr.a, pr.b, p, m);
             }
@@ -165,24 +174,23 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
             // costly part, in narrowphase_clip over the face manifolds only
             let axis = box_box_axis(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
             if (axis.kind != AXIS_APART) {
-                slot = new_manifold(pr.a, pr.b);
+                slot = new_manifold(pr.a, pr.b, axis.kind == AXIS_FACE);
             }
             if (slot != NONE && axis.kind == AXIS_EDGE) {
                 store_manifold(slot, pr.a, pr.b, p, box_box_edge(a.centre, a.rot, a.half, b.centre, b.rot, b.half, axis));
             } else if (slot != NONE) {
-                var pending: ContactManifold;
-                pending.normal = axis.normal;
-                pending.count = 0u;
-                pending.a = pr.a;
-                pending.b = pr.b;
-                pending.clip_face = axis.face;
-                pending.pair = p;
-                manifolds[slot] = pending;
+                // pending: what narrowphase_clip needs (the points follow)
+                manifolds[slot].normal = axis.normal;
+                manifolds[slot].count = 0u;
+                manifolds[slot].a = pr.a;
+                manifolds[slot].b = pr.b;
+                manifolds[slot].clip_face = axis.face;
+                manifolds[slot].pair = p;
             }
         } else {
             let m = collide_with_sphere(a, b, margin);
             if (m.count > 0u) {
-                slot = new_manifold(pr.a, pr.b);
+                slot = new_manifold(pr.a, pr.b, false);
                 if (slot != NONE) {
                     store_manifold(slot, pr.a, pr.b, p, m);
                 }
@@ -191,21 +199,19 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// Pass "narrowphase_clip", after contact_lists (which sizes its dispatch),
-// one invocation per manifold of the pool: the points of the face contacts
-// the narrowphase left pending (clip_face), so the clipping runs only where
-// boxes touch face-on. (A face contact whose clipping keeps no point stays,
-// empty: it pushes nothing.)
+// Pass "narrowphase_clip", after contact_lists (which sizes its dispatch,
+// over the whole pool), one invocation per face contact the narrowphase left
+// pending (clip_face; the top run of the pool, see new_manifold): its
+// points, so the clipping runs only where boxes touch face-on; invocations
+// past that run return at once. (A face contact whose clipping keeps no
+// point stays, empty: it pushes nothing.)
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let k = gid.x;
-    if (k >= manifolds_used()) {
+    if (gid.x >= min(atomicLoad(&status[6]), manifolds_used())) {
         return;
     }
+    let k = arrayLength(&manifolds) - 1u - gid.x;
     let face = manifolds[k].clip_face;
-    if (face == NONE) {
-        return;
-    }
     let ia = manifolds[k].a;
     let ib = manifolds[k].b;
     let a = shape_of(ia);

@@ -47,10 +47,10 @@ fn end_velocity_before(i: u32) -> Velocity {
 
 @compute @workgroup_size(WORKGROUP)
 fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let k = gid.x;
-    if (k >= manifolds_used()) {
+    if (gid.x >= manifolds_used()) {
         return;
     }
+    let k = pool_slot(gid.x);
     let a = manifolds[k].a;
     let b = manifolds[k].b;
     let ea = contact_end(a);

@@ -40,10 +40,10 @@ fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>
 // computed as if it alone turned the body.
 @compute @workgroup_size(WORKGROUP)
 fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let k = gid.x;
-    if (k >= manifolds_used()) {
+    if (gid.x >= manifolds_used()) {
         return;
     }
+    let k = pool_slot(gid.x);
     let ea = contact_end(manifolds[k].a);
     let eb = contact_end(manifolds[k].b);
     if (!ea.moves && !eb.moves) {
