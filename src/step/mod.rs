@@ -1,10 +1,11 @@
 //! The compute pipelines of one step, in the order they run:
 //!
 //! 1. `grid_*`       — broadphase: counting sort of bodies into a hashed grid (shaders/grid.wgsl)
-//! 2. `pairs_*`      — every candidate pair once, and each body's list of its pairs (shaders/pairs.wgsl)
-//! 3. `narrowphase`  — one invocation per pair: its manifold, into the pool (shaders/narrowphase.wgsl, collide.wgsl);
-//!    (boxes: the separating axis); `contact_lists` keeps in each body's list only its
-//!    pairs with a manifold; `narrowphase_clip` clips the face contacts, over the pool
+//! 2. `pairs_*`      — every candidate pair once, where each body's pairs start (shaders/pairs.wgsl)
+//! 3. `narrowphase`  — one invocation per pair: its manifold, into the pool, listed in both
+//!    bodies' contact lists (shaders/narrowphase.wgsl, collide.wgsl; boxes: the separating
+//!    axis); `contact_lists` sorts each body's list into pair order; `narrowphase_clip`
+//!    clips the face contacts, over the top run of the pool
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
 //! 5. `solve_contacts`, `solve` — `iterations` Jacobi sweeps of corrective snaps:
 //!    per manifold what it asks of its bodies, then per body the sum (shaders/solve.wgsl)
