@@ -13,6 +13,8 @@ use verlet::render::{self, Renderer};
 use verlet::track::Track;
 use verlet::{gpu::Gpu, output, scenes, Error, Scene, World};
 
+mod plot;
+
 #[derive(Parser)]
 #[command(name = "verlet", version, about = "GPU rigid-body simulator (quaternion position-Verlet, Kenwright)")]
 struct Cli {
@@ -72,6 +74,10 @@ struct BenchArgs {
     /// Write one CSV row per case here.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Draw the report here, as SVG: ms per step against bodies (ours and
+    /// the peer's, log axes) and each case's step split into its parts.
+    #[arg(long)]
+    plot: Option<PathBuf>,
     /// Do not run the rapier3d peer even when it is built in.
     #[arg(long)]
     no_peer: bool,
@@ -187,22 +193,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run(args),
         Command::Scene { name, count, seed } => print_scene(&name, count, seed),
         Command::Info => info(),
-        Command::Bench(a) => verlet::bench::run(&verlet::bench::Options {
-            cases: a.cases,
-            steps: a.steps,
-            body_steps: a.body_steps,
-            reps: a.reps,
-            quick: a.quick,
-            profile_steps: a.profile_steps,
-            json: a.json,
-            csv: a.csv,
-            no_peer: a.no_peer,
-            peer_max_bodies: a.peer_max_bodies,
-            rapier_sleeping: a.rapier_sleeping,
-            rapier_iterations: a.rapier_iterations,
-            command: std::env::args().collect::<Vec<_>>().join(" "),
-        })
-        .map(|_| ()),
+        Command::Bench(a) => bench(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -211,6 +202,49 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `verlet bench`: the library runs and reports; the chart (`--plot`) is
+/// drawn here, so the library holds no plotting.
+fn bench(a: BenchArgs) -> Result<(), verlet::Error> {
+    if let Some(path) = &a.plot {
+        if path.extension().is_none_or(|e| !e.eq_ignore_ascii_case("svg")) {
+            return Err(verlet::Error::Input(format!(
+                "--plot: {} does not end in .svg: the chart is written as SVG",
+                path.display()
+            )));
+        }
+        // before the long run, as the library does for --json and --csv
+        verlet::output::check_output("--plot", path)?;
+        let outputs: Vec<(&str, &Path)> = [("--json", &a.json), ("--csv", &a.csv), ("--plot", &a.plot)]
+            .into_iter()
+            .filter_map(|(flag, p)| p.as_deref().map(|p| (flag, p)))
+            .collect();
+        verlet::output::check_distinct(&[], &outputs)?;
+    }
+    let report = verlet::bench::run(&verlet::bench::Options {
+        cases: a.cases,
+        steps: a.steps,
+        body_steps: a.body_steps,
+        reps: a.reps,
+        quick: a.quick,
+        profile_steps: a.profile_steps,
+        json: a.json,
+        csv: a.csv,
+        no_peer: a.no_peer,
+        peer_max_bodies: a.peer_max_bodies,
+        rapier_sleeping: a.rapier_sleeping,
+        rapier_iterations: a.rapier_iterations,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+    })?;
+    if let Some(path) = &a.plot {
+        let title = format!("{} on {} ({} cores)", report.adapter, report.cpu, report.cores);
+        let peer = report.peer.split_whitespace().next().unwrap_or("peer").to_string();
+        let chart = plot::svg(&title, &peer, &plot::rows(&report)).map_err(|why| verlet::Error::Input(format!("--plot: {why}")))?;
+        verlet::output::write_file(path, &chart)?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
 }
 
 /// One line for a command-line error: clap's first line, or for a value

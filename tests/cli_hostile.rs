@@ -176,6 +176,7 @@ fn outputs_that_are_inputs_or_each_other_are_refused() {
     let dot_scene = format!("{}/./scene.json", s(&dir));
     let out_csv = dir.join("out.csv");
     let (sc, tr, oc) = (s(&scene), s(&track), s(&out_csv));
+    let plot = format!("{}/out.svg", s(&dir));
     let before = listing(&dir);
     for (args, wanted) in [
         (vec!["run", sc, "--steps", "1", "--state-out", sc], vec!["--state-out", "scene file"]),
@@ -185,6 +186,7 @@ fn outputs_that_are_inputs_or_each_other_are_refused() {
         (vec!["run", sc, "--steps", "1", "--trace", oc, "--state-out", oc], vec!["--state-out", "--trace"]),
         (vec!["run", sc, "--steps", "1", "--gif", oc, "--contact-sheet", oc], vec!["--contact-sheet", "--gif"]),
         (vec!["bench", "--cases", "chain", "--json", oc, "--csv", oc], vec!["--csv", "--json"]),
+        (vec!["bench", "--cases", "chain", "--csv", &plot, "--plot", &plot], vec!["--plot", "--csv"]),
     ] {
         assert_refused_quickly(&args, &wanted.iter().map(|w| &**w).collect::<Vec<_>>());
         assert_eq!(std::fs::read(&scene).unwrap(), original, "{args:?}: the scene changed");
@@ -208,6 +210,7 @@ fn unusable_output_paths_are_refused_before_the_first_step() {
     let file = dir.join("scene.json");
     let inside_file = format!("{}/x.json", s(&file));
     let missing = format!("{}/no/such/dir/x.json", s(&dir));
+    let missing_svg = format!("{}/no/such/dir/x.svg", s(&dir));
     // a long run: refused at once, not after it
     let long = ["run", "--builtin", "cubes", "--count", "1000", "--steps", "1000000"];
     for (flag, path, why) in [
@@ -223,10 +226,14 @@ fn unusable_output_paths_are_refused_before_the_first_step() {
     for (flag, args) in [
         ("--json", vec!["bench", "--cases", "chain", "--json", &missing]),
         ("--csv", vec!["bench", "--cases", "chain", "--csv", s(&dir)]),
+        ("--plot", vec!["bench", "--cases", "chain", "--plot", &missing_svg]),
     ] {
         assert_refused_quickly(&args, &[flag]);
         assert!(!Path::new(&missing).exists());
     }
+    // the chart is SVG: another name is refused, not written as SVG under it
+    let png = format!("{}/chart.png", s(&dir));
+    assert_refused_quickly(&["bench", "--cases", "chain", "--plot", &png], &["--plot", "chart.png", ".svg"]);
     assert_eq!(listing(&dir), ["scene.json"], "nothing created");
     let _ = std::fs::remove_dir_all(&dir);
 }
