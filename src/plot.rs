@@ -126,44 +126,49 @@ fn scaling_chart(area: &Area, peer: &str, rows: &[Row]) -> DrawResult {
     Ok(())
 }
 
-/// Each case's ms per step split into its parts, stacked.
+/// Each case's step split into its parts, as shares of the step (so cases
+/// of any size compare), stacked; the row names the step's total.
 fn parts_chart(area: &Area, rows: &[Row]) -> DrawResult {
-    let split: Vec<(&str, [f64; 5])> = rows.iter().filter_map(|r| r.parts.map(|p| (r.case.as_str(), p))).collect();
+    let split: Vec<(String, [f64; 5])> = rows
+        .iter()
+        .filter_map(|r| r.parts.map(|p| (r, p, p.iter().sum::<f64>())))
+        .filter(|(_, _, total)| *total > 0.0)
+        .map(|(r, p, total)| (format!("{} ({:.1} ms)", r.case, total), p.map(|x| 100.0 * x / total)))
+        .collect();
     if split.is_empty() {
         area.draw_text("no per-stage times in this run (--profile-steps 0)", &("sans-serif", 14).into(), (40, 240))?;
         return Ok(());
     }
-    let widest = split.iter().map(|(_, p)| p.iter().sum::<f64>()).fold(0.0, f64::max).max(1e-3);
-    let names: Vec<String> = split.iter().map(|(c, _)| c.to_string()).collect();
     let mut chart = ChartBuilder::on(area)
-        .caption("where a step goes (ms per step, GPU timestamps)", ("sans-serif", 16))
+        .caption("where a step goes (share of the GPU time, %)", ("sans-serif", 16))
         .margin(12)
         .x_label_area_size(40)
-        .y_label_area_size(90)
+        .y_label_area_size(130)
         // room on the right for the legend
-        .build_cartesian_2d(0.0..widest * 1.4, 0.0..split.len() as f64)?;
+        .build_cartesian_2d(0.0..135.0, 0.0..split.len() as f64)?;
     chart
         .configure_mesh()
         .disable_y_mesh()
         .y_labels(split.len() * 2 + 1)
         .y_label_formatter(&|y| {
             let k = y.floor() as usize;
-            if (y - k as f64 - 0.5).abs() < 0.01 {
-                names.get(k).cloned().unwrap_or_default()
-            } else {
-                String::new()
-            }
+            if (y - k as f64 - 0.5).abs() < 0.01 { split.get(k).map(|s| s.0.clone()).unwrap_or_default() } else { String::new() }
         })
-        .x_desc("ms per step")
+        .x_labels(8)
+        .x_label_formatter(&|x| if *x <= 100.0 { format!("{x:.0}") } else { String::new() })
+        .x_desc("% of the step")
         .draw()?;
     for (part, (name, colour)) in PARTS.iter().zip(PART_COLOURS).enumerate() {
         let bars = split.iter().enumerate().map(|(k, (_, p))| {
             let from: f64 = p[..part].iter().sum();
             Rectangle::new([(from, k as f64 + 0.2), (from + p[part], k as f64 + 0.8)], colour.filled())
         });
-        chart.draw_series(bars)?.label(*name).legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled()));
+        chart
+            .draw_series(bars)?
+            .label(*name)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled()));
     }
-    chart.configure_series_labels().position(SeriesLabelPosition::LowerRight).border_style(BLACK).background_style(WHITE).draw()?;
+    chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).border_style(BLACK).background_style(WHITE).draw()?;
     Ok(())
 }
 
@@ -196,7 +201,7 @@ mod tests {
             [row("pile-1k", 1000, 15.0, Some(6.9)), row("pile-10k", 10_000, 114.6, Some(101.2)), row("pyramid", 210, 9.0, None)];
         let svg = svg("llvmpipe, 2 cores", "rapier3d", &rows).unwrap();
         assert!(svg.starts_with("<svg"), "{}", &svg[..80.min(svg.len())]);
-        for label in ["verlet, pile", "rapier3d, pile", "verlet, pyramid", "pile-1k", "pile-10k", "pyramid", "llvmpipe, 2 cores"] {
+        for label in ["verlet, pile", "rapier3d, pile", "verlet, pyramid", "pile-1k (15.0 ms)", "pile-10k (114.6 ms)", "pyramid (9.0 ms)", "llvmpipe, 2 cores"] {
             assert!(svg.contains(label), "no {label:?} in the chart");
         }
         for part in PARTS {
