@@ -152,7 +152,11 @@ fn parts_chart(area: &Area, rows: &[Row]) -> DrawResult {
         .y_labels(split.len() * 2 + 1)
         .y_label_formatter(&|y| {
             let k = y.floor() as usize;
-            if (y - k as f64 - 0.5).abs() < 0.01 { split.get(k).map(|s| s.0.clone()).unwrap_or_default() } else { String::new() }
+            if (y - k as f64 - 0.5).abs() < 0.01 {
+                split.get(k).map(|s| s.0.clone()).unwrap_or_default()
+            } else {
+                String::new()
+            }
         })
         .x_labels(8)
         .x_label_formatter(&|x| if *x <= 100.0 { format!("{x:.0}") } else { String::new() })
@@ -163,10 +167,7 @@ fn parts_chart(area: &Area, rows: &[Row]) -> DrawResult {
             let from: f64 = p[..part].iter().sum();
             Rectangle::new([(from, k as f64 + 0.2), (from + p[part], k as f64 + 0.8)], colour.filled())
         });
-        chart
-            .draw_series(bars)?
-            .label(*name)
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled()));
+        chart.draw_series(bars)?.label(*name).legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled()));
     }
     chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).border_style(BLACK).background_style(WHITE).draw()?;
     Ok(())
@@ -201,7 +202,15 @@ mod tests {
             [row("pile-1k", 1000, 15.0, Some(6.9)), row("pile-10k", 10_000, 114.6, Some(101.2)), row("pyramid", 210, 9.0, None)];
         let svg = svg("llvmpipe, 2 cores", "rapier3d", &rows).unwrap();
         assert!(svg.starts_with("<svg"), "{}", &svg[..80.min(svg.len())]);
-        for label in ["verlet, pile", "rapier3d, pile", "verlet, pyramid", "pile-1k (15.0 ms)", "pile-10k (114.6 ms)", "pyramid (9.0 ms)", "llvmpipe, 2 cores"] {
+        for label in [
+            "verlet, pile",
+            "rapier3d, pile",
+            "verlet, pyramid",
+            "pile-1k (15.0 ms)",
+            "pile-10k (114.6 ms)",
+            "pyramid (9.0 ms)",
+            "llvmpipe, 2 cores",
+        ] {
             assert!(svg.contains(label), "no {label:?} in the chart");
         }
         for part in PARTS {
