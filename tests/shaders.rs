@@ -39,3 +39,36 @@ fn the_input_kernels_validate() {
         assert_eq!(span as usize, size, "{name}: WGSL size {span}, host size {size}");
     }
 }
+
+/// Every stage's declared reads and writes (`Stage::reads`, `Stage::writes`)
+/// are what naga finds its entry point doing with the step's buffers, and the
+/// buffers no stage writes are the ones bindings.wgsl declares read-only
+/// (the layout derives its read-only flags from the declarations).
+#[test]
+fn every_stage_declares_the_buffers_it_reads_and_writes() {
+    use verlet::step::{Buffer, Stage};
+    let bindings = |list: &[Buffer]| {
+        let mut b: Vec<u32> = list.iter().map(|b| b.binding()).collect();
+        b.sort();
+        b
+    };
+    for stage in Stage::ALL {
+        let uses = shaders::buffer_uses(stage.name()).unwrap();
+        let reads: Vec<u32> = uses.iter().filter(|u| u.1).map(|u| u.0).collect();
+        let writes: Vec<u32> = uses.iter().filter(|u| u.2).map(|u| u.0).collect();
+        assert_eq!(bindings(stage.reads()), reads, "{}: the bindings it reads", stage.name());
+        assert_eq!(bindings(stage.writes()), writes, "{}: the bindings it writes", stage.name());
+    }
+    let source = shaders::pass_source("integrate").unwrap();
+    let module = shaders::validate(&source).unwrap();
+    for buffer in &Buffer::ALL[1..] {
+        let (_, var) = module
+            .global_variables
+            .iter()
+            .find(|(_, v)| v.binding.as_ref().is_some_and(|b| b.binding == buffer.binding()))
+            .unwrap_or_else(|| panic!("bindings.wgsl declares no binding {}", buffer.binding()));
+        let naga::AddressSpace::Storage { access } = var.space else { panic!("{buffer:?} is not a storage buffer") };
+        let declared_read_only = !access.contains(naga::StorageAccess::STORE);
+        assert_eq!(buffer.read_only(), declared_read_only, "{buffer:?} ({:?}): read-only in the layout", var.name);
+    }
+}

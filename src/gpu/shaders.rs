@@ -60,3 +60,31 @@ pub fn validate(source: &str) -> Result<naga::Module, String> {
         .map_err(|e| e.emit_to_string(source))?;
     Ok(module)
 }
+
+/// What the named pass's entry point does with each buffer of the step's
+/// bind group, as naga's analysis finds it: (binding, reads, writes), in
+/// binding order, for every buffer it touches. `arrayLength` alone is
+/// neither a read nor a write.
+pub fn buffer_uses(name: &str) -> Result<Vec<(u32, bool, bool)>, String> {
+    let source = pass_source(name).ok_or_else(|| format!("no pass {name}"))?;
+    let entry = entry_point(name).ok_or_else(|| format!("no pass {name}"))?;
+    let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .map_err(|e| e.emit_to_string(&source))?;
+    let index =
+        module.entry_points.iter().position(|e| e.name == entry).ok_or_else(|| format!("{name}: no entry point {entry}"))?;
+    let uses = info.get_entry_point(index);
+    let mut out: Vec<(u32, bool, bool)> = module
+        .global_variables
+        .iter()
+        .filter_map(|(handle, var)| {
+            let binding = var.binding.as_ref()?.binding;
+            let used = uses[handle];
+            let (reads, writes) = (used.contains(naga::valid::GlobalUse::READ), used.contains(naga::valid::GlobalUse::WRITE));
+            (reads || writes).then_some((binding, reads, writes))
+        })
+        .collect();
+    out.sort();
+    Ok(out)
+}

@@ -65,6 +65,61 @@ pub enum Over {
     Manifolds,
 }
 
+/// The buffers of the step's bind group, by binding (shaders/bindings.wgsl,
+/// which names them; ARCHITECTURE.md says who writes what and why).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Buffer {
+    Params = 0,
+    Props = 1,
+    StateIn = 2,
+    StateOut = 3,
+    Vel0 = 4,
+    CellCount = 5,
+    CellStart = 6,
+    BlockSums = 7,
+    Sorted = 8,
+    Snaps = 9,
+    Pairs = 10,
+    Manifolds = 11,
+    Status = 12,
+    JointStart = 13,
+    JointRefs = 14,
+    PairMeta = 15,
+    BodyPairs = 16,
+}
+
+impl Buffer {
+    pub const ALL: [Buffer; 17] = [
+        Buffer::Params,
+        Buffer::Props,
+        Buffer::StateIn,
+        Buffer::StateOut,
+        Buffer::Vel0,
+        Buffer::CellCount,
+        Buffer::CellStart,
+        Buffer::BlockSums,
+        Buffer::Sorted,
+        Buffer::Snaps,
+        Buffer::Pairs,
+        Buffer::Manifolds,
+        Buffer::Status,
+        Buffer::JointStart,
+        Buffer::JointRefs,
+        Buffer::PairMeta,
+        Buffer::BodyPairs,
+    ];
+
+    pub fn binding(self) -> u32 {
+        self as u32
+    }
+
+    /// Whether no stage writes the buffer: its binding is then read-only
+    /// in the layout (as bindings.wgsl must declare it).
+    pub fn read_only(self) -> bool {
+        Stage::ALL.iter().all(|s| !s.writes().contains(&self))
+    }
+}
+
 impl Stage {
     pub const ALL: [Stage; 20] = [
         Stage::GridClear,
@@ -113,6 +168,56 @@ impl Stage {
             Stage::Solve => "solve",
             Stage::RestitutionContacts => "restitution_contacts",
             Stage::Restitution => "restitution",
+        }
+    }
+
+    /// The buffers the stage's entry point reads and writes: every buffer
+    /// its code can touch, as naga's analysis of the entry point finds it
+    /// (`tests/shaders.rs` checks both lists against it), so a branch not
+    /// taken counts (the pair walks share one walk that writes in
+    /// `pairs_write` and counts in `pairs_count`; the scan passes hold the
+    /// grid's case and the pairs' both). An atomic is a read and a write.
+    pub fn reads(self) -> &'static [Buffer] {
+        use Buffer::*;
+        match self {
+            Stage::GridClear => &[Params],
+            Stage::GridCount => &[Params, Props, StateIn, CellCount, PairMeta],
+            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, PairMeta],
+            Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
+            Stage::GridScanAdd | Stage::PairsScanAdd => &[Params, CellStart, BlockSums, PairMeta],
+            Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
+            Stage::GridSort => &[Params, CellStart, Sorted],
+            Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta],
+            Stage::PairsWrite => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta, BodyPairs],
+            Stage::Narrowphase => &[Params, Props, StateIn, Pairs, Status, PairMeta],
+            Stage::ContactLists => &[Params, Manifolds, Status, PairMeta, BodyPairs],
+            Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
+            Stage::Integrate => &[Params, Props, StateIn, Status, JointStart, PairMeta],
+            Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status],
+            Stage::Solve => &[Params, Props, StateIn, Snaps, JointStart, JointRefs, PairMeta, BodyPairs],
+            Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status],
+            Stage::Restitution => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs],
+        }
+    }
+
+    /// See [`Stage::reads`].
+    pub fn writes(self) -> &'static [Buffer] {
+        use Buffer::*;
+        match self {
+            Stage::GridClear => &[CellCount, Status],
+            Stage::GridCount => &[CellCount, PairMeta],
+            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[CellStart, BlockSums, PairMeta],
+            Stage::GridScanSums | Stage::PairsScanSums => &[CellStart, BlockSums, Status, PairMeta],
+            Stage::GridScanAdd | Stage::PairsScanAdd => &[CellCount, CellStart, PairMeta],
+            Stage::GridScatter => &[CellCount, Sorted],
+            Stage::GridSort => &[Sorted],
+            Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
+            Stage::Narrowphase => &[Manifolds, Status, PairMeta, BodyPairs],
+            Stage::ContactLists => &[Status, PairMeta, BodyPairs],
+            Stage::NarrowphaseClip => &[Manifolds, PairMeta],
+            Stage::Integrate => &[StateOut, Vel0, Status, PairMeta],
+            Stage::SolveContacts | Stage::RestitutionContacts => &[Snaps, Manifolds],
+            Stage::Solve | Stage::Restitution => &[StateOut],
         }
     }
 
@@ -205,9 +310,9 @@ impl StepPipelines {
             },
             count: None,
         }];
-        let read_only = [1, 2, 13, 14]; // props, state_in, joint_start, joint_refs
-        for binding in 1..=STORAGE_BUFFERS {
-            entries.push(storage(binding, read_only.contains(&binding)));
+        // read-only where no stage writes (props, state_in, the joints)
+        for buffer in &Buffer::ALL[1..] {
+            entries.push(storage(buffer.binding(), buffer.read_only()));
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("step"), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
