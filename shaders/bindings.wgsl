@@ -59,3 +59,56 @@ fn pool_slot(k: u32) -> u32 {
     let bottom = manifolds_used() - top;
     return select(k, arrayLength(&manifolds) - top + (k - bottom), k >= bottom);
 }
+
+// Helpers that read the bindings (common.wgsl binds nothing).
+
+// The snap manifold `r >> 1` asks of the body that holds reference r.
+fn snap_of(r: u32) -> EndSnap {
+    if ((r & 1u) != 0u) {
+        return snaps[r >> 1u].b;
+    }
+    return snaps[r >> 1u].a;
+}
+
+// Sleeping (settings.sleeping; the paper has none). A body that has been
+// slower than SLEEP_SPEED while touching something for params.sleep_after
+// seconds sleeps: integrate holds it still, without gravity, the solve and
+// restitution passes leave it as it is, and every awake body treats it as
+// fixed. It wakes when an awake body touching it moves faster than
+// WAKE_SPEED or lies more than WAKE_DEPTH inside it, and every body wakes
+// after any user input or edit. BodyState
+// rest_time counts the seconds at rest. Bodies with joints never sleep.
+fn asleep(s: BodyState) -> bool {
+    return params.sleep_after > 0.0 && s.rest_time >= params.sleep_after;
+}
+
+const SLEEP_SPEED: f32 = 0.05; // m/s
+const WAKE_SPEED: f32 = 0.2;   // m/s
+// An awake body this far inside a sleeper wakes it too (m): it is being
+// squeezed against something that cannot give way.
+const WAKE_DEPTH: f32 = 0.01;
+
+// Whether an awake body touching a sleeper at points `gap` apart (m) wakes it.
+fn wakes(j: u32, gap: f32) -> bool {
+    let o = state_in[j];
+    return !asleep(o) && (gap < -WAKE_DEPTH || point_speed(o, props[j]) > WAKE_SPEED);
+}
+
+// An upper bound of the speed of any point of a body over the last substep
+// (m/s): the centre's speed plus the spin times the bounding radius.
+fn point_speed(s: BodyState, p: BodyProps) -> f32 {
+    let spin = length(quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))));
+    return (length(s.disp) + spin * p.half_extents.w) / params.dt_prev;
+}
+
+fn contact_end(i: u32) -> ContactEnd {
+    if (i == GROUND) {
+        let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), false,
+                          params.ground_restitution, params.ground_friction);
+    }
+    let s = state_in[i];
+    let p = props[i];
+    return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
+                      p.restitution, p.friction);
+}

@@ -1,6 +1,12 @@
-// Shared by every compute pass: the body layout, the per-step parameters and
-// the quaternion helpers. Every struct here has a #[repr(C)] twin in
-// src/gpu/types.rs, checked member by member by tests/layouts.rs.
+// Types and maths that bind nothing, shared by every compute pass and the
+// renderer: the body layout, the per-step parameters, the contact records
+// and the quaternion helpers. Every struct here has a #[repr(C)] twin in
+// src/gpu/types.rs, checked member by member by tests/layouts.rs. The
+// constants shared with Rust (NONE, GROUND, WORLD, HELD, MAX_POINTS,
+// SHAPE_*, FLAG_FIXED, GRID_BODY, LARGE_BODY, WORKGROUP, SCAN_BLOCK, the
+// fault codes and limits) are not written here: src/gpu/shaders.rs writes
+// them from the Rust values, before this file, in every module. Helpers
+// that read the step's bindings live in bindings.wgsl.
 
 // Pose of one body: what swaps between the two state buffers every pass.
 // 64 bytes. Quaternions are (x, y, z, w).
@@ -24,12 +30,6 @@ struct BodyState {
     prev_rot: vec4<f32>, // orientation one step ago
 }
 
-// BodyState.pos_low bit 31: something besides gravity held the body over
-// the last substep: a contact pushed it (the solve sets it; integrate's
-// test for sleeping reads it), or it is fixed or asleep. The host then
-// reports disp / h as its velocity, without the half substep of gravity
-// that a free body's disp / h lags by (World::read_state).
-const HELD: u32 = 0x80000000u;
 
 // One step of pos_remainder's grid for a coordinate x (m): 1/512 of x's f32
 // spacing, floored at 2^-92 m so that it never underflows.
@@ -180,19 +180,6 @@ fn contact_ref(manifold: u32, is_b: bool) -> u32 {
     return 2u * manifold + u32(is_b);
 }
 
-// The snap manifold `r >> 1` asks of the body that holds reference r.
-fn snap_of(r: u32) -> EndSnap {
-    if ((r & 1u) != 0u) {
-        return snaps[r >> 1u].b;
-    }
-    return snaps[r >> 1u].a;
-}
-
-// Points a manifold holds (box-box manifolds are reduced to four).
-const MAX_POINTS: u32 = 4u;
-// No manifold / no pair.
-const NONE: u32 = 0xffffffffu;
-
 // Fastest speed (m/s) at which the solve pushes apart bodies that already
 // overlapped at their previous poses (Box2D's contact push speed is 3 m/s).
 const MAX_DEPENETRATION_SPEED: f32 = 3.0;
@@ -209,22 +196,6 @@ struct JointRef {
     local_partner: vec3<f32>,
     _pad0: u32,
 }
-
-const WORLD: u32 = 0xffffffffu;
-
-// The partner of a contact with the ground plane.
-const GROUND: u32 = 0xffffffffu;
-
-// BodyProps.grid_class: in the broadphase grid, or too large for it.
-const GRID_BODY: u32 = 0u;
-const LARGE_BODY: u32 = 1u;
-
-const SHAPE_BOX: u32 = 0u;
-const SHAPE_SPHERE: u32 = 1u;
-const FLAG_FIXED: u32 = 1u;
-
-// Threads per workgroup of every per-body pass.
-const WORKGROUP: u32 = 64u;
 
 // Hamilton product a * b.
 fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
@@ -316,37 +287,6 @@ fn effective_inv_mass(p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>
     return p.inv_inertia.w + dot(rn, inv_inertia_world(rot, p.inv_inertia.xyz, rn));
 }
 
-// Sleeping (settings.sleeping; the paper has none). A body that has been
-// slower than SLEEP_SPEED while touching something for params.sleep_after
-// seconds sleeps: integrate holds it still, without gravity, the solve and
-// restitution passes leave it as it is, and every awake body treats it as
-// fixed. It wakes when an awake body touching it moves faster than
-// WAKE_SPEED or lies more than WAKE_DEPTH inside it, and every body wakes
-// after any user input or edit. BodyState
-// rest_time counts the seconds at rest. Bodies with joints never sleep.
-fn asleep(s: BodyState) -> bool {
-    return params.sleep_after > 0.0 && s.rest_time >= params.sleep_after;
-}
-
-const SLEEP_SPEED: f32 = 0.05; // m/s
-const WAKE_SPEED: f32 = 0.2;   // m/s
-// An awake body this far inside a sleeper wakes it too (m): it is being
-// squeezed against something that cannot give way.
-const WAKE_DEPTH: f32 = 0.01;
-
-// Whether an awake body touching a sleeper at points `gap` apart (m) wakes it.
-fn wakes(j: u32, gap: f32) -> bool {
-    let o = state_in[j];
-    return !asleep(o) && (gap < -WAKE_DEPTH || point_speed(o, props[j]) > WAKE_SPEED);
-}
-
-// An upper bound of the speed of any point of a body over the last substep
-// (m/s): the centre's speed plus the spin times the bounding radius.
-fn point_speed(s: BodyState, p: BodyProps) -> f32 {
-    let spin = length(quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))));
-    return (length(s.disp) + spin * p.half_extents.w) / params.dt_prev;
-}
-
 // One body of a contact manifold as the contact passes see it: its poses
 // (the current one and how it got there from the previous),
 // masses and material; the ground is an end at the origin with no mass.
@@ -359,18 +299,6 @@ struct ContactEnd {
     moves: bool,            // awake and not fixed: the contacts may move it
     restitution: f32,
     friction: f32,
-}
-
-fn contact_end(i: u32) -> ContactEnd {
-    if (i == GROUND) {
-        let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-        return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), false,
-                          params.ground_restitution, params.ground_friction);
-    }
-    let s = state_in[i];
-    let p = props[i];
-    return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
-                      p.restitution, p.friction);
 }
 
 // Generalised inverse mass of an end for a unit push along dir at offset r;

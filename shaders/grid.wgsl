@@ -18,7 +18,7 @@
 // (pair_meta's owned and total -> owned_start and list_start), and the
 // single workgroup also writes the narrowphase's indirect dispatch.
 
-const SCAN_BLOCK: u32 = 256u;
+// SCAN_BLOCK: buckets (or bodies) summed per workgroup (shared with Rust).
 
 fn cell_of(p: vec3<f32>) -> vec3<i32> {
     return vec3<i32>(floor(p / params.cell_size));

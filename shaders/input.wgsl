@@ -31,16 +31,13 @@ struct InputOp {
     c: vec4<f32>,
 }
 
-// a.xyz = impulse (N s); a.w = 0 at the centre, 1 at world point b.xyz,
-// 2 at body-frame point b.xyz
-const INPUT_IMPULSE: u32 = 0u;
-// a.xyz = position, b = unit orientation; velocities are kept
-const INPUT_POSE: u32 = 1u;
-// a.xyz = linear (m/s), b.xyz = angular (rad/s, world frame)
-const INPUT_VELOCITY: u32 = 2u;
-// a.x = 1: make fixed; a.x = 0: make dynamic with mass a.y (kg), or with the
-// mass kept when it was made fixed (kept_inv_mass) if a.y = 0
-const INPUT_FIXED: u32 = 3u;
+// InputOp.kind (the values come from src/world/input.rs, before this file):
+// INPUT_IMPULSE: a.xyz = impulse (N s); a.w = 0 at the centre, 1 at world
+//   point b.xyz, 2 at body-frame point b.xyz
+// INPUT_POSE: a.xyz = position, b = unit orientation; velocities are kept
+// INPUT_VELOCITY: a.xyz = linear (m/s), b.xyz = angular (rad/s, world frame)
+// INPUT_FIXED: a.x = 1: make fixed; a.x = 0: make dynamic with mass a.y (kg),
+//   or with the mass kept when it was made fixed (kept_inv_mass) if a.y = 0
 
 // and bindings.wgsl's state_out (binding 3): the current state buffer
 @group(0) @binding(20) var<uniform> input: InputHeader;

@@ -46,17 +46,11 @@ fn woken(i: u32) -> bool {
 // pair holds less than half a turn per substep (a bigger turn reads as a
 // smaller one the other way), so a spin is also absurd where it turns more
 // than MAX_TURN in one substep, whatever MAX_SPIN allows.
-const MAX_DISTANCE: f32 = 1e6;
-const MAX_SPEED: f32 = 1e4;
-const MAX_SPIN: f32 = 1e4;
-const MAX_TURN: f32 = 3.0;
-// status[3] (and status[2]) before any fault.
-const NO_FAULT: u32 = 0xffffffffu;
-// What was wrong, in the low two bits of status[2] (4 * body + FAULT_*).
-const FAULT_NON_FINITE: u32 = 0u;
-const FAULT_FAR: u32 = 1u;
-const FAULT_FAST: u32 = 2u;
-const FAULT_SPIN: u32 = 3u;
+// MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN (m, m/s, rad/s, rad per
+// substep), NO_FAULT (status[3] and status[2] before any fault) and what was
+// wrong, in the low two bits of status[2] (4 * body + FAULT_*):
+// FAULT_NON_FINITE, FAULT_FAR, FAULT_FAST, FAULT_SPIN; shared with Rust
+// (src/world.rs), which decodes them.
 
 // No infinity or NaN (exponent bits all set): WGSL has no isNan, and x != x
 // may be folded away by a driver's fast-math.

@@ -16,17 +16,8 @@
 // depth buffer then keeps its precision from a body at the near plane to
 // the horizon of the ground.
 
-// The pose of one body (64 bytes): the layout of `BodyState` in common.wgsl
-// and src/gpu/types.rs, declared again here so the renderer does not depend
-// on the step's bindings (tests/render.rs checks the two stay alike).
-struct BodyState {
-    pos: vec3<f32>,
-    rest_time: f32,
-    disp: vec3<f32>,
-    pos_low: u32,
-    rot: vec4<f32>,
-    prev_rot: vec4<f32>,
-}
+// BodyState, quat_rotate, SHAPE_BOX and SHAPE_SPHERE come from common.wgsl
+// and the shared constants, put before this file (src/render.rs).
 
 // The renderer's constants (208 bytes), written once; `Globals` in src/render.rs.
 struct Globals {
@@ -70,21 +61,12 @@ struct JointLine {
     body_b: i32,
 }
 
-const SHAPE_BOX: u32 = 0u;
-const SHAPE_SPHERE: u32 = 1u;
-
 @group(0) @binding(0) var<uniform> globals: Globals;
 @group(0) @binding(1) var<storage, read> states: array<BodyState>;
 @group(0) @binding(2) var<storage, read> bodies: array<RenderBody>;
 @group(0) @binding(3) var<storage, read> joints: array<JointLine>;
 @group(1) @binding(0) var shadow_map: texture_depth_2d;
 @group(1) @binding(1) var shadow_sampler: sampler_comparison;
-
-// v turned by the unit quaternion q (x, y, z, w)
-fn quat_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
-    let t = 2.0 * cross(q.xyz, v);
-    return v + q.w * t + cross(q.xyz, t);
-}
 
 // The share of sunlight reaching a point (0 = in shadow), filtered over 3x3
 // texels of the shadow map. Outside the map everything is lit.

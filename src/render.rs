@@ -35,8 +35,14 @@ use crate::scene::{Scene, Shape, DEFAULT_FOV_Y};
 use crate::world::World;
 use crate::Error;
 
-/// The WGSL of every render pipeline.
-pub const SHADER: &str = include_str!("../shaders/render.wgsl");
+/// shaders/render.wgsl, the render pipelines' own part.
+pub const RENDER: &str = include_str!("../shaders/render.wgsl");
+
+/// The WGSL of every render pipeline: the shared constants, common.wgsl (the
+/// body's pose and the quaternion helpers; it binds nothing), render.wgsl.
+pub fn shader_source() -> String {
+    crate::gpu::shaders::shared_constants() + crate::gpu::shaders::COMMON + RENDER
+}
 
 /// Samples per pixel: 4x MSAA, which WebGPU guarantees for both formats below.
 pub const SAMPLES: u32 = 4;
@@ -164,7 +170,7 @@ impl RenderPipelines {
     pub fn new(device: &wgpu::Device) -> RenderPipelines {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         let storage = |binding: u32| wgpu::BindGroupLayoutEntry {
             binding,

@@ -195,13 +195,13 @@ pub const MAX_TURN: f32 = 3.0;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FaultKind {
     /// An infinity or a NaN in its pose.
-    NonFinite,
+    NonFinite = 0,
     /// Farther than `MAX_DISTANCE` from the origin.
-    TooFar,
+    TooFar = 1,
     /// Faster than `MAX_SPEED`.
-    TooFast,
+    TooFast = 2,
     /// Spinning faster than `MAX_SPIN`, or turning more than `MAX_TURN` in a substep.
-    SpinsTooFast,
+    SpinsTooFast = 3,
 }
 
 /// The first numerical fault the GPU found: the lowest body found bad in the
@@ -817,12 +817,7 @@ fn decode_fault(code: u32, step: u32) -> Option<Fault> {
     if step == NO_FAULT || code == NO_FAULT {
         return None;
     }
-    let kind = match code & 3 {
-        0 => FaultKind::NonFinite,
-        1 => FaultKind::TooFar,
-        2 => FaultKind::TooFast,
-        _ => FaultKind::SpinsTooFast,
-    };
+    let kind = [FaultKind::NonFinite, FaultKind::TooFar, FaultKind::TooFast, FaultKind::SpinsTooFast][(code & 3) as usize];
     Some(Fault { body: (code / 4) as usize, step: step as u64, kind })
 }
 

@@ -31,7 +31,7 @@ macro_rules! check_layout {
 
 #[test]
 fn shared_structs_match_member_by_member() {
-    let common = &format!("{}{}", shaders::COMMON, shaders::BINDINGS);
+    let common = &format!("{}{}{}", shaders::shared_constants(), shaders::COMMON, shaders::BINDINGS);
     check_layout!(common, BodyState { pos, rest_time, disp, pos_low, rot, prev_rot });
     check_layout!(
         common,
@@ -74,45 +74,63 @@ fn shared_structs_match_member_by_member() {
     check_layout!(common, PairMeta { owned, total, owned_start, list_start, cursor, woken, moves, contacts, extent, reach });
 }
 
+/// The constants WGSL shares with Rust are written once, from the Rust values
+/// (shaders::shared_constants): every module sees them with those values.
 #[test]
 fn constants_match() {
-    let module = shaders::validate(&format!("{}{}", shaders::COMMON, shaders::BINDINGS)).unwrap();
-    let find = |name: &str| {
-        let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
-        match module.global_expressions[c.init] {
-            naga::Expression::Literal(naga::Literal::U32(v)) => v,
-            ref e => panic!("{name}: unexpected {e:?}"),
-        }
-    };
-    assert_eq!(find("SHAPE_BOX"), SHAPE_BOX);
-    assert_eq!(find("SHAPE_SPHERE"), SHAPE_SPHERE);
-    assert_eq!(find("FLAG_FIXED"), FLAG_FIXED);
-    assert_eq!(find("GRID_BODY"), GRID_BODY);
-    assert_eq!(find("LARGE_BODY"), LARGE_BODY);
-    assert_eq!(find("WORKGROUP"), WORKGROUP);
-    assert_eq!(find("MAX_POINTS"), MAX_POINTS);
-    assert_eq!(find("NONE"), NONE);
-    assert_eq!(find("GROUND"), GROUND);
-    assert_eq!(find("WORLD"), WORLD);
-    // the numerical-fault codes the host decodes (src/world.rs)
-    let integrate = verlet::gpu::shaders::pass_source("integrate").unwrap();
+    let integrate = shaders::pass_source("integrate").unwrap();
     let module = shaders::validate(&integrate).unwrap();
     let constant = |name: &str| {
         let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
         module.global_expressions[c.init].clone()
     };
-    assert!(matches!(constant("NO_FAULT"), naga::Expression::Literal(naga::Literal::U32(verlet::world::NO_FAULT))));
-    assert!(matches!(constant("MAX_SPEED"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_SPEED));
-    assert!(
-        matches!(constant("MAX_DISTANCE"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_DISTANCE)
-    );
-    assert!(matches!(constant("MAX_SPIN"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_SPIN));
-    assert!(matches!(constant("MAX_TURN"), naga::Expression::Literal(naga::Literal::F32(v)) if v == verlet::world::MAX_TURN));
-    for (name, code) in [("FAULT_NON_FINITE", 0u32), ("FAULT_FAR", 1), ("FAULT_FAST", 2), ("FAULT_SPIN", 3)] {
-        assert!(matches!(constant(name), naga::Expression::Literal(naga::Literal::U32(v)) if v == code), "{name}");
+    let word = |name: &str| match constant(name) {
+        naga::Expression::Literal(naga::Literal::U32(v)) => v,
+        e => panic!("{name}: unexpected {e:?}"),
+    };
+    let float = |name: &str| match constant(name) {
+        naga::Expression::Literal(naga::Literal::F32(v)) => v,
+        e => panic!("{name}: unexpected {e:?}"),
+    };
+    use verlet::world::{FaultKind, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
+    for (name, value) in [
+        ("SHAPE_BOX", SHAPE_BOX),
+        ("SHAPE_SPHERE", SHAPE_SPHERE),
+        ("FLAG_FIXED", FLAG_FIXED),
+        ("GRID_BODY", GRID_BODY),
+        ("LARGE_BODY", LARGE_BODY),
+        ("WORKGROUP", WORKGROUP),
+        ("SCAN_BLOCK", SCAN_BLOCK),
+        ("MAX_POINTS", MAX_POINTS),
+        ("NONE", NONE),
+        ("GROUND", GROUND),
+        ("WORLD", WORLD),
+        ("HELD", HELD),
+        ("NO_FAULT", NO_FAULT),
+        ("FAULT_NON_FINITE", FaultKind::NonFinite as u32),
+        ("FAULT_FAR", FaultKind::TooFar as u32),
+        ("FAULT_FAST", FaultKind::TooFast as u32),
+        ("FAULT_SPIN", FaultKind::SpinsTooFast as u32),
+    ] {
+        assert_eq!(word(name), value, "{name}");
     }
-    let grid = format!("{}{}{}", shaders::COMMON, shaders::BINDINGS, shaders::GRID);
-    let module = shaders::validate(&grid).unwrap();
-    let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some("SCAN_BLOCK")).unwrap();
-    assert!(matches!(module.global_expressions[c.init], naga::Expression::Literal(naga::Literal::U32(SCAN_BLOCK))));
+    for (name, value) in [("MAX_SPEED", MAX_SPEED), ("MAX_DISTANCE", MAX_DISTANCE), ("MAX_SPIN", MAX_SPIN), ("MAX_TURN", MAX_TURN)]
+    {
+        assert_eq!(float(name).to_bits(), value.to_bits(), "{name}");
+    }
+    // an awkward value survives the round trip exactly
+    let awkward = shaders::wgsl_f32("X", 0.1 + f32::EPSILON);
+    let module = shaders::validate(&awkward).unwrap();
+    let (_, c) = module.constants.iter().next().unwrap();
+    assert!(
+        matches!(module.global_expressions[c.init], naga::Expression::Literal(naga::Literal::F32(v)) if v == 0.1 + f32::EPSILON)
+    );
+}
+
+/// common.wgsl holds types and maths only: with the shared constants it is a
+/// module of its own, binding nothing (the renderer includes it).
+#[test]
+fn common_wgsl_binds_nothing() {
+    let module = shaders::validate(&(shaders::shared_constants() + shaders::COMMON)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(module.global_variables.len(), 0, "common.wgsl declares a binding");
 }

@@ -289,7 +289,7 @@ fn spheres_and_fixed_bodies_render() {
 
 #[test]
 fn the_render_shader_validates_with_naga() {
-    let module = verlet::gpu::shaders::validate(render::SHADER).unwrap_or_else(|e| panic!("render.wgsl:\n{e}"));
+    let module = verlet::gpu::shaders::validate(&render::shader_source()).unwrap_or_else(|e| panic!("render.wgsl:\n{e}"));
     for name in ["body_vertex", "body_fragment", "ground_vertex", "ground_fragment", "joint_vertex", "joint_fragment"] {
         assert!(module.entry_points.iter().any(|e| e.name == name), "no entry point {name}");
     }
@@ -311,7 +311,7 @@ fn wgsl_layout(source: &str, name: &str) -> (Vec<(String, u32)>, u32) {
 macro_rules! check_layout {
     ($ty:path, $name:literal { $($field:ident),* $(,)? }) => {{
         let rust: Vec<(String, u32)> = vec![$((stringify!($field).to_string(), std::mem::offset_of!($ty, $field) as u32)),*];
-        let (wgsl, span) = wgsl_layout(render::SHADER, $name);
+        let (wgsl, span) = wgsl_layout(&render::shader_source(), $name);
         assert_eq!(wgsl, rust, "{}: members differ between render.wgsl and Rust", $name);
         assert_eq!(span as usize, std::mem::size_of::<$ty>(), "{}: size differs", $name);
     }};
@@ -322,7 +322,7 @@ fn render_structs_match_the_wgsl() {
     check_layout!(render::Globals, "Globals" { view_proj, light_view_proj, eye, light_dir, ground, grid, background });
     check_layout!(render::RenderBody, "RenderBody" { half_extents, body, color, shape });
     check_layout!(render::JointLine, "JointLine" { anchor_a, body_a, anchor_b, body_b });
-    // the renderer's copy of the pose matches the step's
+    // the renderer reads the step's pose (common.wgsl's BodyState)
     check_layout!(verlet::gpu::types::BodyState, "BodyState" { pos, rest_time, disp, pos_low, rot, prev_rot });
 }
 

@@ -14,7 +14,12 @@ fn every_pass_validates_with_naga() {
 
 #[test]
 fn a_broken_shader_is_refused() {
-    let source = format!("{}{}\nfn broken() -> f32 {{ return vec3<f32>(1.0); }}", shaders::COMMON, shaders::BINDINGS);
+    let source = format!(
+        "{}{}{}\nfn broken() -> f32 {{ return vec3<f32>(1.0); }}",
+        shaders::shared_constants(),
+        shaders::COMMON,
+        shaders::BINDINGS
+    );
     assert!(shaders::validate(&source).is_err());
 }
 

@@ -11,6 +11,53 @@ pub const INTEGRATE: &str = include_str!("../../shaders/integrate.wgsl");
 pub const SOLVE: &str = include_str!("../../shaders/solve.wgsl");
 pub const RESTITUTION: &str = include_str!("../../shaders/restitution.wgsl");
 
+/// The constants the WGSL shares with Rust, written once: from the Rust
+/// values, as WGSL `const` declarations that go first in every module (the
+/// step's passes, the input kernels, the renderer).
+pub fn shared_constants() -> String {
+    use crate::gpu::types::*;
+    use crate::world::{FaultKind, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
+    let mut out = String::from("// Shared with Rust: written by src/gpu/shaders.rs from the Rust constants.\n");
+    let words = [
+        ("NONE", NONE),
+        ("GROUND", GROUND),
+        ("WORLD", WORLD),
+        ("HELD", HELD),
+        ("MAX_POINTS", MAX_POINTS),
+        ("SHAPE_BOX", SHAPE_BOX),
+        ("SHAPE_SPHERE", SHAPE_SPHERE),
+        ("FLAG_FIXED", FLAG_FIXED),
+        ("GRID_BODY", GRID_BODY),
+        ("LARGE_BODY", LARGE_BODY),
+        ("WORKGROUP", WORKGROUP),
+        ("SCAN_BLOCK", SCAN_BLOCK),
+        ("NO_FAULT", NO_FAULT),
+        ("FAULT_NON_FINITE", FaultKind::NonFinite as u32),
+        ("FAULT_FAR", FaultKind::TooFar as u32),
+        ("FAULT_FAST", FaultKind::TooFast as u32),
+        ("FAULT_SPIN", FaultKind::SpinsTooFast as u32),
+    ];
+    for (name, value) in words {
+        out += &wgsl_u32(name, value);
+    }
+    for (name, value) in [("MAX_DISTANCE", MAX_DISTANCE), ("MAX_SPEED", MAX_SPEED), ("MAX_SPIN", MAX_SPIN), ("MAX_TURN", MAX_TURN)]
+    {
+        out += &wgsl_f32(name, value);
+    }
+    out
+}
+
+/// `const NAME: u32 = value;` in WGSL.
+pub fn wgsl_u32(name: &str, value: u32) -> String {
+    format!("const {name}: u32 = {value}u;\n")
+}
+
+/// `const NAME: f32 = value;` in WGSL, the value exactly (Rust's shortest
+/// round-trip form always has a point or an exponent).
+pub fn wgsl_f32(name: &str, value: f32) -> String {
+    format!("const {name}: f32 = {value:?};\n")
+}
+
 const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
 const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
 const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE];
@@ -42,9 +89,10 @@ pub const PASSES: &[(&str, &str, &[&str])] = &[
     ("restitution", "restitution", &[COMMON, BINDINGS, RESTITUTION]),
 ];
 
-/// The assembled source of the named pass.
+/// The assembled source of the named pass: the shared constants, then its
+/// pieces.
 pub fn pass_source(name: &str) -> Option<String> {
-    PASSES.iter().find(|(n, _, _)| *n == name).map(|(_, _, parts)| parts.concat())
+    PASSES.iter().find(|(n, _, _)| *n == name).map(|(_, _, parts)| shared_constants() + &parts.concat())
 }
 
 /// The entry point of the named pass.

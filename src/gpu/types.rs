@@ -28,8 +28,11 @@ pub struct BodyState {
     pub prev_rot: [f32; 4],
 }
 
-/// `BodyState::pos_low` bit: something besides gravity held the body over
-/// the last substep: a contact pushed it, or it is fixed or asleep.
+/// `BodyState::pos_low` bit 31: something besides gravity held the body over
+/// the last substep: a contact pushed it (the solve sets it; integrate's test
+/// for sleeping reads it), or it is fixed or asleep. The host then reports
+/// disp / h as its velocity, without the half substep of gravity that a free
+/// body's disp / h lags by (`World::read_state`).
 pub const HELD: u32 = 0x8000_0000;
 
 /// Shape, mass and material of one body (64 bytes), read-only on the GPU.
@@ -223,8 +226,10 @@ pub const NONE: u32 = u32::MAX;
 /// Buckets summed per workgroup by the grid scan (`SCAN_BLOCK` in WGSL).
 pub const SCAN_BLOCK: u32 = 256;
 
+/// `BodyProps::shape`.
 pub const SHAPE_BOX: u32 = 0;
 pub const SHAPE_SPHERE: u32 = 1;
+/// `BodyProps::flags` bit: the body never moves.
 pub const FLAG_FIXED: u32 = 1;
 /// `BodyProps::grid_class` of a body in the broadphase grid, and of one too
 /// large for it (`GRID_BODY`, `LARGE_BODY` in WGSL).

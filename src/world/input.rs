@@ -31,7 +31,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use super::World;
-use crate::gpu::shaders::{BINDINGS, COMMON};
+use crate::gpu::shaders::{shared_constants, wgsl_u32, BINDINGS, COMMON};
 use crate::gpu::types::WORKGROUP;
 use crate::Error;
 
@@ -47,10 +47,20 @@ const EXPLODE: usize = 1;
 const WIND: usize = 2;
 const WAKE_ALL: usize = 3;
 
-/// The assembled WGSL module: common.wgsl, bindings.wgsl (only for the
-/// declarations common.wgsl's helpers name; none of them is bound), input.wgsl.
+/// The assembled WGSL module: the shared constants (with the input ops'
+/// kinds), common.wgsl, bindings.wgsl (for the declarations its helpers
+/// name; only the state and properties are bound), input.wgsl.
 pub fn source() -> String {
-    [COMMON, BINDINGS, INPUT].concat()
+    let mut constants = shared_constants();
+    for (name, kind) in [
+        ("INPUT_IMPULSE", INPUT_IMPULSE),
+        ("INPUT_POSE", INPUT_POSE),
+        ("INPUT_VELOCITY", INPUT_VELOCITY),
+        ("INPUT_FIXED", INPUT_FIXED),
+    ] {
+        constants += &wgsl_u32(name, kind);
+    }
+    [constants.as_str(), COMMON, BINDINGS, INPUT].concat()
 }
 
 /// Where an impulse or force acts on a body.
@@ -185,6 +195,7 @@ pub struct InputOp {
     pub c: [f32; 4],
 }
 
+/// `InputOp::kind` (input.wgsl reads them from here: `source`).
 const INPUT_IMPULSE: u32 = 0;
 const INPUT_POSE: u32 = 1;
 const INPUT_VELOCITY: u32 = 2;
