@@ -78,7 +78,7 @@ fn shared_structs_match_member_by_member() {
 /// (shaders::shared_constants): every module sees them with those values.
 #[test]
 fn constants_match() {
-    let integrate = shaders::pass_source("integrate").unwrap();
+    let integrate = verlet::step::Stage::Integrate.source();
     let module = shaders::validate(&integrate).unwrap();
     let constant = |name: &str| {
         let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);

@@ -4,11 +4,10 @@ use verlet::gpu::shaders;
 
 #[test]
 fn every_pass_validates_with_naga() {
-    assert!(!shaders::PASSES.is_empty());
-    for (name, entry, _) in shaders::PASSES {
-        let source = shaders::pass_source(name).unwrap();
-        let module = shaders::validate(&source).unwrap_or_else(|e| panic!("{name}.wgsl does not validate:\n{e}"));
-        assert!(module.entry_points.iter().any(|e| e.name == *entry), "{name}: no entry point {entry}");
+    for stage in verlet::step::Stage::ALL {
+        let (name, entry) = (stage.name(), stage.entry_point());
+        let module = shaders::validate(&stage.source()).unwrap_or_else(|e| panic!("{name} does not validate:\n{e}"));
+        assert!(module.entry_points.iter().any(|e| e.name == entry), "{name}: no entry point {entry}");
     }
 }
 
@@ -58,13 +57,13 @@ fn every_stage_declares_the_buffers_it_reads_and_writes() {
         b
     };
     for stage in Stage::ALL {
-        let uses = shaders::buffer_uses(stage.name()).unwrap();
+        let uses = shaders::buffer_uses(&stage.source(), stage.entry_point()).unwrap();
         let reads: Vec<u32> = uses.iter().filter(|u| u.1).map(|u| u.0).collect();
         let writes: Vec<u32> = uses.iter().filter(|u| u.2).map(|u| u.0).collect();
         assert_eq!(bindings(stage.reads()), reads, "{}: the bindings it reads", stage.name());
         assert_eq!(bindings(stage.writes()), writes, "{}: the bindings it writes", stage.name());
     }
-    let source = shaders::pass_source("integrate").unwrap();
+    let source = verlet::step::Stage::Integrate.source();
     let module = shaders::validate(&source).unwrap();
     for buffer in &Buffer::ALL[1..] {
         let (_, var) = module

@@ -58,47 +58,13 @@ pub fn wgsl_f32(name: &str, value: f32) -> String {
     format!("const {name}: f32 = {value:?};\n")
 }
 
-const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
-const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
-const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE];
-
-/// Every compute pass: its name (the label of its compute pass), its entry
-/// point (named like the pass, but for the scan passes, which grid.wgsl
-/// holds once for the grid and the pairs) and the pieces of its module, in
-/// order.
-pub const PASSES: &[(&str, &str, &[&str])] = &[
-    ("grid_clear", "grid_clear", GRID_PASS),
-    ("grid_count", "grid_count", GRID_PASS),
-    ("grid_scan_blocks", "scan_blocks", GRID_PASS),
-    ("grid_scan_sums", "scan_sums", GRID_PASS),
-    ("grid_scan_add", "scan_add", GRID_PASS),
-    ("grid_scatter", "grid_scatter", GRID_PASS),
-    ("grid_sort", "grid_sort", GRID_PASS),
-    ("pairs_count", "pairs_count", PAIRS_PASS),
-    ("pairs_scan_blocks", "scan_blocks", GRID_PASS),
-    ("pairs_scan_sums", "scan_sums", GRID_PASS),
-    ("pairs_scan_add", "scan_add", GRID_PASS),
-    ("pairs_write", "pairs_write", PAIRS_PASS),
-    ("narrowphase", "narrowphase", NARROWPHASE_PASS),
-    ("contact_lists", "contact_lists", NARROWPHASE_PASS),
-    ("narrowphase_clip", "narrowphase_clip", NARROWPHASE_PASS),
-    ("integrate", "integrate", &[COMMON, BINDINGS, INTEGRATE]),
-    ("solve_contacts", "solve_contacts", &[COMMON, BINDINGS, SOLVE]),
-    ("solve", "solve", &[COMMON, BINDINGS, SOLVE]),
-    ("restitution_contacts", "restitution_contacts", &[COMMON, BINDINGS, RESTITUTION]),
-    ("restitution", "restitution", &[COMMON, BINDINGS, RESTITUTION]),
-];
-
-/// The assembled source of the named pass: the shared constants, then its
-/// pieces.
-pub fn pass_source(name: &str) -> Option<String> {
-    PASSES.iter().find(|(n, _, _)| *n == name).map(|(_, _, parts)| shared_constants() + &parts.concat())
-}
-
-/// The entry point of the named pass.
-pub fn entry_point(name: &str) -> Option<&'static str> {
-    PASSES.iter().find(|(n, _, _)| *n == name).map(|(_, e, _)| *e)
-}
+/// The pieces of the step's passes' modules, in order (see `Stage::pieces`).
+pub const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
+pub const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
+pub const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE];
+pub const INTEGRATE_PASS: &[&str] = &[COMMON, BINDINGS, INTEGRATE];
+pub const SOLVE_PASS: &[&str] = &[COMMON, BINDINGS, SOLVE];
+pub const RESTITUTION_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION];
 
 /// Parses and validates WGSL with naga, as the device would.
 pub fn validate(source: &str) -> Result<naga::Module, String> {
@@ -109,19 +75,16 @@ pub fn validate(source: &str) -> Result<naga::Module, String> {
     Ok(module)
 }
 
-/// What the named pass's entry point does with each buffer of the step's
-/// bind group, as naga's analysis finds it: (binding, reads, writes), in
-/// binding order, for every buffer it touches. `arrayLength` alone is
-/// neither a read nor a write.
-pub fn buffer_uses(name: &str) -> Result<Vec<(u32, bool, bool)>, String> {
-    let source = pass_source(name).ok_or_else(|| format!("no pass {name}"))?;
-    let entry = entry_point(name).ok_or_else(|| format!("no pass {name}"))?;
-    let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
+/// What entry point `entry` of the WGSL `source` does with each buffer it
+/// binds, as naga's analysis finds it: (binding, reads, writes), in binding
+/// order, for every buffer it touches. `arrayLength` alone is neither a
+/// read nor a write.
+pub fn buffer_uses(source: &str, entry: &str) -> Result<Vec<(u32, bool, bool)>, String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
     let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
         .validate(&module)
-        .map_err(|e| e.emit_to_string(&source))?;
-    let index =
-        module.entry_points.iter().position(|e| e.name == entry).ok_or_else(|| format!("{name}: no entry point {entry}"))?;
+        .map_err(|e| e.emit_to_string(source))?;
+    let index = module.entry_points.iter().position(|e| e.name == entry).ok_or_else(|| format!("no entry point {entry}"))?;
     let uses = info.get_entry_point(index);
     let mut out: Vec<(u32, bool, bool)> = module
         .global_variables

@@ -144,8 +144,8 @@ impl Stage {
         Stage::Restitution,
     ];
 
-    /// The pass's name: its label, and the key of its module in
-    /// `shaders::PASSES` (which names its entry point).
+    /// The pass's name: the label of its compute pass, and its entry point
+    /// but for the scan passes (see `entry_point`).
     pub fn name(self) -> &'static str {
         match self {
             Stage::GridClear => "grid_clear",
@@ -169,6 +169,35 @@ impl Stage {
             Stage::RestitutionContacts => "restitution_contacts",
             Stage::Restitution => "restitution",
         }
+    }
+
+    /// The WGSL entry point: named like the stage, but for the scan passes,
+    /// which grid.wgsl holds once for the grid and the pairs (the override
+    /// constant SCAN_PAIRS tells them apart).
+    pub fn entry_point(self) -> &'static str {
+        match self {
+            Stage::GridScanBlocks | Stage::PairsScanBlocks => "scan_blocks",
+            Stage::GridScanSums | Stage::PairsScanSums => "scan_sums",
+            Stage::GridScanAdd | Stage::PairsScanAdd => "scan_add",
+            other => other.name(),
+        }
+    }
+
+    /// The WGSL files its module is made of, in order (src/gpu/shaders.rs).
+    pub fn pieces(self) -> &'static [&'static str] {
+        match self {
+            Stage::PairsCount | Stage::PairsWrite => shaders::PAIRS_PASS,
+            Stage::Narrowphase | Stage::ContactLists | Stage::NarrowphaseClip => shaders::NARROWPHASE_PASS,
+            Stage::Integrate => shaders::INTEGRATE_PASS,
+            Stage::SolveContacts | Stage::Solve => shaders::SOLVE_PASS,
+            Stage::RestitutionContacts | Stage::Restitution => shaders::RESTITUTION_PASS,
+            _ => shaders::GRID_PASS,
+        }
+    }
+
+    /// Its module's source: the shared constants, then its pieces.
+    pub fn source(self) -> String {
+        shaders::shared_constants() + &self.pieces().concat()
     }
 
     /// The buffers the stage's entry point reads and writes: every buffer
@@ -323,7 +352,7 @@ impl StepPipelines {
         let pipelines = Stage::ALL
             .iter()
             .map(|stage| {
-                let source = shaders::pass_source(stage.name()).expect("every stage has a shader");
+                let source = stage.source();
                 let constants: &[(&str, f64)] = if stage.scans_pairs() { &[("SCAN_PAIRS", 1.0)] } else { &[] };
                 let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some(stage.name()),
@@ -333,7 +362,7 @@ impl StepPipelines {
                     label: Some(stage.name()),
                     layout: Some(&pipeline_layout),
                     module: &module,
-                    entry_point: shaders::entry_point(stage.name()),
+                    entry_point: Some(stage.entry_point()),
                     compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
                     cache: None,
                 })
