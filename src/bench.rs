@@ -440,18 +440,7 @@ impl CopyKernel {
             mapped_at_creation: false,
         });
         gpu.queue.write_buffer(&count, 0, bytemuck::cast_slice(&[n as u32, 0, 0, 0]));
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("copy_state"),
-            source: wgpu::ShaderSource::Wgsl(COPY_WGSL.into()),
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("copy_state"),
-            layout: None,
-            module: &module,
-            entry_point: Some("copy_state"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = gpu.compute_pipelines("copy_state", COPY_WGSL, &["copy_state"], None, &[]).remove(0);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("copy_state"),
             layout: &pipeline.get_bind_group_layout(0),

@@ -69,6 +69,46 @@ impl fmt::Debug for Gpu {
 }
 
 impl Gpu {
+    /// Compute pipelines for the entry points `entries` of one WGSL module:
+    /// the one way every compute kernel here is built (the step's passes,
+    /// the input kernels, the bench's copy kernel). `bind_groups`: the
+    /// layouts of its bind groups, or None to take them from the shader
+    /// (`get_bind_group_layout`); `constants`: override constants.
+    pub fn compute_pipelines(
+        &self,
+        label: &str,
+        source: &str,
+        entries: &[&str],
+        bind_groups: Option<&[&wgpu::BindGroupLayout]>,
+        constants: &[(&str, f64)],
+    ) -> Vec<wgpu::ComputePipeline> {
+        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let layout = bind_groups.map(|groups| {
+            let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+            self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &groups,
+                immediate_size: 0,
+            })
+        });
+        entries
+            .iter()
+            .map(|entry| {
+                self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: layout.as_ref(),
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+                    cache: None,
+                })
+            })
+            .collect()
+    }
+
     /// Opens the adapter that wgpu's environment variables select
     /// (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`, `WGPU_POWER_PREF`), else the
     /// default one; on a machine with no GPU that is a software adapter.

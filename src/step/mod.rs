@@ -344,28 +344,11 @@ impl StepPipelines {
             entries.push(storage(buffer.binding(), buffer.read_only()));
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("step"), entries: &entries });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("step"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         let pipelines = Stage::ALL
             .iter()
-            .map(|stage| {
-                let source = stage.source();
+            .flat_map(|stage| {
                 let constants: &[(&str, f64)] = if stage.scans_pairs() { &[("SCAN_PAIRS", 1.0)] } else { &[] };
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(stage.name()),
-                    source: wgpu::ShaderSource::Wgsl(source.into()),
-                });
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(stage.name()),
-                    layout: Some(&pipeline_layout),
-                    module: &module,
-                    entry_point: Some(stage.entry_point()),
-                    compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-                    cache: None,
-                })
+                gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[&layout]), constants)
             })
             .collect();
         StepPipelines { layout, pipelines }

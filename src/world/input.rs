@@ -503,25 +503,7 @@ impl World {
                         entry(BIND_PROPS, storage(false)),
                     ],
                 });
-                let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("input"),
-                    bind_group_layouts: &[Some(&layout)],
-                    immediate_size: 0,
-                });
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some("input"),
-                    source: wgpu::ShaderSource::Wgsl(source().into()),
-                });
-                let pipeline = |entry: &str| {
-                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(entry),
-                        layout: Some(&pipeline_layout),
-                        module: &module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-                };
+                let pipelines = self.gpu.compute_pipelines("input", &source(), &ENTRY_POINTS, Some(&[&layout]), &[]);
                 let header = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("input/header"),
                     size: std::mem::size_of::<InputHeader>() as u64,
@@ -532,7 +514,7 @@ impl World {
                 let list = ops_buffer(capacity);
                 let groups = bind_groups(&layout, &header, &list);
                 self.input = Some(InputGpu {
-                    pipelines: ENTRY_POINTS.map(pipeline),
+                    pipelines: pipelines.try_into().expect("a pipeline per entry point"),
                     layout,
                     header,
                     ops: list,
