@@ -7,7 +7,7 @@ use glam::{DQuat, DVec3};
 
 use crate::gpu::{types::*, Gpu};
 use crate::scene::{Body, Scene, Settings, Shape};
-use crate::step::{Over, Stage, StepPipelines, STORAGE_BUFFERS};
+use crate::step::{Buffer, Over, Stage, StepPipelines, STORAGE_BUFFERS};
 use crate::Error;
 
 pub mod edit;
@@ -631,6 +631,48 @@ impl World {
         if stage.flips_state() {
             self.current = 1 - self.current;
         }
+    }
+
+    /// Runs `stages` alone, in order, each as a step's first substep runs it,
+    /// and leaves the step count as it was: a way to check one kernel
+    /// against a known answer (tests/kernels.rs), not a way to simulate.
+    #[doc(hidden)]
+    pub fn run_stages(&mut self, stages: &[Stage]) -> Result<(), Error> {
+        self.write_params(&[self.settings.dt], self.settings.substeps as usize);
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stages") });
+        for &stage in stages {
+            self.encode_pass(&mut encoder, stage, 0, None);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        Ok(self.gpu.wait()?)
+    }
+
+    /// One of the step's buffers, read back as 32-bit words (tests).
+    #[doc(hidden)]
+    pub fn read_words(&self, buffer: Buffer) -> Result<Vec<u32>, Error> {
+        let [vel0, cell_count, cell_start, block_sums, sorted] = &self.data.scratch;
+        let [_, joint_start, joint_refs] = &self.data.statics;
+        let d = &self.data;
+        let b = match buffer {
+            Buffer::Params => &d.params,
+            Buffer::Props => &d.props,
+            Buffer::StateIn => &d.states[self.current],
+            Buffer::StateOut => &d.states[1 - self.current],
+            Buffer::Vel0 => vel0,
+            Buffer::CellCount => cell_count,
+            Buffer::CellStart => cell_start,
+            Buffer::BlockSums => block_sums,
+            Buffer::Sorted => sorted,
+            Buffer::Snaps => &d.snaps,
+            Buffer::Pairs => &d.pairs,
+            Buffer::Manifolds => &d.manifolds,
+            Buffer::Status => &d.status,
+            Buffer::JointStart => joint_start,
+            Buffer::JointRefs => joint_refs,
+            Buffer::PairMeta => &d.pair_meta,
+            Buffer::BodyPairs => &d.body_pairs,
+        };
+        Ok(bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(b, b.size())?))
     }
 
     /// Takes `steps` steps of `settings.dt` one at a time, timing every pass:

@@ -1,0 +1,188 @@
+//! Known answers, kernel by kernel: each test runs only the stages it needs
+//! (`World::run_stages`) and checks what one kernel wrote against what it
+//! must write, so a regression names its pass.
+
+mod common;
+
+use common::world;
+use glam::{Quat, Vec3};
+use verlet::scenes::{box_body, sphere_body};
+use verlet::step::{Buffer, Stage};
+use verlet::world::plan_grid;
+use verlet::{Scene, Settings};
+
+/// The stages before `integrate`: the grid, the pair list, the narrowphase.
+fn contacts_stages() -> Vec<Stage> {
+    Stage::ALL.iter().copied().take_while(|&s| s != Stage::Integrate).collect()
+}
+
+fn grid_stages() -> Vec<Stage> {
+    Stage::ALL.iter().copied().filter(|s| s.is_broadphase()).collect()
+}
+
+struct Rng(u64);
+impl Rng {
+    fn f(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// The grid kernels sort the bodies as a CPU counting sort does: by hash
+/// bucket of their cell (grid.wgsl's bucket_of), by index within a bucket,
+/// the bodies kept out of the grid at the tail; cell_start holds the
+/// buckets' prefix sums.
+#[test]
+fn the_grid_is_a_counting_sort_by_bucket() {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut bodies = Vec::new();
+    for k in 0..700 {
+        let at = [40.0 * rng.f() - 20.0, 30.0 * rng.f() - 5.0, 40.0 * rng.f() - 20.0];
+        bodies.push(if k % 3 == 0 { sphere_body(0.2 + 0.3 * rng.f(), at) } else { box_body([0.3, 0.2 + 0.2 * rng.f(), 0.4], at) });
+    }
+    // two bodies too large for the cells
+    bodies.push(box_body([6.0, 0.5, 6.0], [0.0, -3.0, 0.0]));
+    bodies.push(sphere_body(4.0, [10.0, 10.0, 10.0]));
+    let scene = Scene {
+        settings: Settings { gravity: [0.0; 3], ..Settings::default() },
+        ground: None,
+        bodies,
+        joints: vec![],
+        camera: None,
+    };
+    let Some(mut w) = world(&scene) else { return };
+    w.run_stages(&grid_stages()).unwrap();
+    let sorted = w.read_words(Buffer::Sorted).unwrap();
+    let cell_start = w.read_words(Buffer::CellStart).unwrap();
+
+    let radii: Vec<f32> = scene.bodies.iter().map(|b| b.bounding_radius()).collect();
+    let (large, grid) = plan_grid(&radii);
+    assert_eq!(large, [700, 701], "the two large bodies are kept out of the grid");
+    let states = w.read_raw().unwrap();
+    let bucket = |i: usize| {
+        let p = Vec3::from(states[i].pos);
+        let c = (p / grid.cell_size).floor();
+        let h = (c.x as i32 as u32).wrapping_mul(73_856_093)
+            ^ (c.y as i32 as u32).wrapping_mul(19_349_663)
+            ^ (c.z as i32 as u32).wrapping_mul(83_492_791);
+        h & (grid.hash_size - 1)
+    };
+    let mut expected: Vec<u32> = (0..700).collect();
+    expected.sort_by_key(|&i| (bucket(i as usize), i));
+    expected.extend(&large);
+    assert_eq!(&sorted[..702], &expected[..], "sorted");
+    let mut starts = vec![0u32; grid.hash_size as usize + 1];
+    for i in 0..700 {
+        starts[bucket(i) as usize + 1] += 1;
+    }
+    for h in 0..grid.hash_size as usize {
+        starts[h + 1] += starts[h];
+    }
+    assert_eq!(cell_start[..starts.len()], starts[..], "cell_start");
+}
+
+/// integrate carries a free body's displacement and adds g h^2 (eq. 6 with
+/// a steady step), and repeats its last rotation (eq. 7): bit for bit what
+/// the same f32 sums give on the CPU.
+#[test]
+fn integrate_carries_the_displacement_and_adds_gravity() {
+    let mut body = box_body([0.5, 0.25, 0.4], [3.0, 12.0, -2.0]);
+    body.linear_velocity = [1.5, 2.0, -0.5];
+    body.angular_velocity = [0.3, -1.2, 2.0];
+    body.orientation = Quat::from_rotation_y(0.4).to_array();
+    let scene = Scene { settings: Settings::default(), ground: None, bodies: vec![body], joints: vec![], camera: None };
+    let Some(mut w) = world(&scene) else { return };
+    let before = w.read_raw().unwrap()[0];
+    w.run_stages(&[Stage::Integrate]).unwrap();
+    let after = w.read_raw().unwrap()[0];
+    let h = scene.settings.dt / scene.settings.substeps as f32;
+    let g = Vec3::from(scene.settings.gravity);
+    let disp = Vec3::from(before.disp) + g * (h * 0.5 * (h + h));
+    assert_eq!(Vec3::from(after.disp), disp, "disp");
+    // the position moves by it to within two of its f32 spacings: this
+    // addition's rounding, and the remainder the last one left in pos_low,
+    // added back now (what rounding drops is kept, not lost)
+    let moved = Vec3::from(after.pos) - Vec3::from(before.pos);
+    let spacing = 2.0 * Vec3::from(after.pos).abs() * f32::EPSILON;
+    assert!(((moved - disp).abs() - spacing).max_element() <= 0.0, "moved {moved}, displacement {disp}");
+    assert_eq!(after.prev_rot, before.rot, "the previous rotation is the last one");
+    let last = Quat::from_array(before.rot) * Quat::from_array(before.prev_rot).conjugate();
+    let expected = (last * Quat::from_array(before.rot)).normalize();
+    assert!(Quat::from_array(after.rot).dot(expected).abs() > 1.0 - 1e-6, "rot {:?}, expected {expected:?}", after.rot);
+}
+
+/// One resting contact: a body already inside the ground by d (less than
+/// the depenetration speed allows in a substep), at rest, no gravity. One
+/// sweep (solve_contacts, then solve) lifts it straight up, without turning
+/// it, by c_r d times the share solve.wgsl gives the points: each point's
+/// push is worked out as if it were alone, d / w_k with w_k = 1/m + (r_k x
+/// n) . I^-1 (r_k x n), and their sum moves the body by d sum_k (1/m) / w_k,
+/// scaled down to d where that is more (never up). A sphere (one point,
+/// no turn: the share is 1) and a flat box (four corners, whose turns
+/// absorb part of each push: a share of 0.78 here).
+#[test]
+fn one_sweep_lifts_a_body_out_of_the_ground_by_relaxation_times_depth() {
+    let d = 0.004f32;
+    let h = Vec3::new(0.5, 0.3, 0.4);
+    // the box's corners under it, r x n for n = -y: (r.z, 0, -r.x); m I^-1 of a box
+    let m_inv_inertia = Vec3::new(3.0 / (h.y * h.y + h.z * h.z), 3.0 / (h.x * h.x + h.z * h.z), 3.0 / (h.x * h.x + h.y * h.y));
+    let box_share: f32 = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+        .iter()
+        .map(|&(sx, sz)| {
+            let rn = Vec3::new(sz * h.z, 0.0, -sx * h.x);
+            1.0 / (1.0 + rn.dot(m_inv_inertia * rn))
+        })
+        .sum::<f32>()
+        .min(1.0);
+    for (body, share) in [(sphere_body(0.5, [1.0, 0.5 - d, -2.0]), 1.0), (box_body(h.to_array(), [1.0, 0.3 - d, -2.0]), box_share)]
+    {
+        let settings = Settings { gravity: [0.0; 3], ..Settings::default() };
+        let scene = Scene {
+            settings,
+            ground: Some(verlet::scene::Ground { height: 0.0 }),
+            bodies: vec![body],
+            joints: vec![],
+            camera: None,
+        };
+        let Some(mut w) = world(&scene) else { return };
+        let before = w.read_raw().unwrap()[0];
+        let mut stages = contacts_stages();
+        stages.extend([Stage::SolveContacts, Stage::Solve]);
+        w.run_stages(&stages).unwrap();
+        let after = w.read_raw().unwrap()[0];
+        let lift = Vec3::from(after.pos) - Vec3::from(before.pos);
+        let expected = settings.relaxation * d * share;
+        assert!((lift.y - expected).abs() < 2e-6, "{:?}: lifted {} m, expected {expected}", scene.bodies[0].shape, lift.y);
+        assert!(lift.x.abs() < 1e-6 && lift.z.abs() < 1e-6, "{:?}: moved sideways {lift}", scene.bodies[0].shape);
+        assert!(Quat::from_array(after.rot).dot(Quat::from_array(before.rot)).abs() > 1.0 - 1e-6, "turned");
+        // the snap moves the velocity with it (Verlet)
+        assert!((Vec3::from(after.disp) - Vec3::from(before.disp) - lift).length() < 1e-6, "disp");
+    }
+}
+
+/// restitution: a sphere that hits the ground at 5 m/s in one substep
+/// (no gravity) leaves at e times that once the sweeps have stopped it.
+#[test]
+fn restitution_returns_e_times_the_approach_speed() {
+    let e = 0.5;
+    let mut ball = sphere_body(0.5, [0.0, 0.52, 0.0]);
+    ball.linear_velocity = [0.0, -5.0, 0.0];
+    ball.restitution = Some(e);
+    let settings = Settings { gravity: [0.0; 3], restitution: e, ..Settings::default() };
+    let scene =
+        Scene { settings, ground: Some(verlet::scene::Ground { height: 0.0 }), bodies: vec![ball], joints: vec![], camera: None };
+    let Some(mut w) = world(&scene) else { return };
+    let mut stages = contacts_stages();
+    stages.push(Stage::Integrate);
+    for _ in 0..settings.iterations {
+        stages.extend([Stage::SolveContacts, Stage::Solve]);
+    }
+    stages.extend([Stage::RestitutionContacts, Stage::Restitution]);
+    w.run_stages(&stages).unwrap();
+    let after = w.read_raw().unwrap()[0];
+    let h = settings.dt / settings.substeps as f32;
+    let v = Vec3::from(after.disp) / h;
+    assert!((v.y - e * 5.0).abs() < 1e-3 && v.x.abs() < 1e-5 && v.z.abs() < 1e-5, "left at {v} m/s, expected {} up", e * 5.0);
+}
