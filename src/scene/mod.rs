@@ -1,0 +1,384 @@
+//! Scene files: the types a simulation starts from, loading them from JSON,
+//! checking them, their mass properties, and writing them back as JSON.
+//!
+//! The file format is the contract in `INTERFACE.md`, section 1. Units are SI
+//! (metres, seconds, kilograms, radians unless a name says degrees),
+//! right-handed with +Y up, and quaternions are `[x, y, z, w]`.
+//!
+//! Loading happens in three steps:
+//!
+//! 1. JSON is parsed into private "raw" structs that mirror the file exactly
+//!    and refuse unknown fields. `serde_path_to_error` tells which field a
+//!    parse error belongs to.
+//! 2. The raw structs are turned into [`Scene`]: defaults are filled in,
+//!    required fields are checked to be present, array lengths are checked,
+//!    the mass is resolved from `density` or `mass`, and orientations are
+//!    normalised.
+//! 3. [`Scene::validate`] checks every value (finite numbers, positive sizes,
+//!    parameter ranges, joint indices). It is public so that scenes built in
+//!    Rust get the same checks.
+//!
+//! Every error names the offending field in the form
+//! `bodies[3].shape.half_extents[1]`, says why it is wrong, and fits on one
+//! line. No input makes this module panic.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+/// Density used when a body gives neither `density` nor `mass`: 1000 kg/m³,
+/// the density of water, so a 1 m cube weighs a tonne.
+pub const DEFAULT_DENSITY: f32 = 1000.0;
+
+/// The joint body index that stands for the static world.
+pub const WORLD: i32 = -1;
+
+/// Identity rotation, `[x, y, z, w]`.
+pub const IDENTITY_ORIENTATION: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
+
+/// The most relaxation iterations a step may ask for.
+pub const MAX_ITERATIONS: u32 = 256;
+
+/// The most substeps a step may ask for.
+pub const MAX_SUBSTEPS: u32 = 64;
+
+/// Camera vertical field of view (radians) used when a `camera` block gives
+/// no `fov_y`: 45 degrees, a natural-looking lens that neither distorts nor
+/// flattens much.
+pub const DEFAULT_FOV_Y: f32 = std::f32::consts::FRAC_PI_4;
+
+/// A quaternion whose length is below this is refused: it has no direction
+/// to normalise to.
+const MIN_ORIENTATION_NORM: f64 = 1e-6;
+
+// ---------------------------------------------------------------------------
+// Public types
+// ---------------------------------------------------------------------------
+
+/// A whole scene: global settings, an optional ground plane, the bodies, the
+/// joints between them and an optional camera.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scene {
+    /// Global simulation parameters.
+    pub settings: Settings,
+    /// The ground plane, if any.
+    pub ground: Option<Ground>,
+    /// The rigid bodies. Joints refer to them by index in this list.
+    pub bodies: Vec<Body>,
+    /// Ball joints between bodies, or between a body and the world.
+    pub joints: Vec<Joint>,
+    /// Where to look from when rendering frames (extension to the contract).
+    /// `None` lets the renderer choose a camera that frames the scene.
+    pub camera: Option<Camera>,
+}
+
+/// Global simulation parameters: the `settings` block. Every field is
+/// optional in the file; [`Settings::default`] gives the values used for
+/// missing ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Time step in seconds. Must be finite and > 0.
+    pub dt: f32,
+    /// Gravitational acceleration in m/s², world frame.
+    pub gravity: [f32; 3],
+    /// Relaxation iterations of the constraint solver per step, 1..=256.
+    pub iterations: u32,
+    /// The paper's relaxation coefficient c_r: the fraction of each
+    /// constraint error corrected per iteration, in (0, 1].
+    pub relaxation: f32,
+    /// The paper's β for linear motion: the fraction of linear velocity lost
+    /// per step, in [0, 1).
+    pub linear_damping: f32,
+    /// The paper's β for angular motion: the fraction of angular velocity
+    /// lost per step, in [0, 1).
+    pub angular_damping: f32,
+    /// Coefficient of restitution for contacts, in [0, 1]. Bodies may
+    /// override it.
+    pub restitution: f32,
+    /// Coulomb friction coefficient for contacts, >= 0. Bodies may override
+    /// it.
+    pub friction: f32,
+    /// Substeps per step (extension to the contract): each step of `dt` is
+    /// taken as `substeps` steps of `dt / substeps`. 1..=64, default 3.
+    pub substeps: u32,
+    /// Whether bodies at rest sleep (extension to the contract), default
+    /// true: a body slower than 5 cm/s at every point for `SLEEP_AFTER`
+    /// seconds while touching something is held still until an awake body
+    /// touching it moves faster than 20 cm/s or lies more than 1 cm inside
+    /// it, or any input or edit wakes all. The paper has no sleeping and
+    /// lists that as a weakness.
+    pub sleeping: bool,
+}
+
+/// Seconds at rest before a body sleeps (Box2D's time to sleep).
+pub const SLEEP_AFTER: f32 = 0.5;
+
+impl Default for Settings {
+    /// The values shown in `INTERFACE.md`:
+    ///
+    /// - `dt` 1/60 s: one step per frame of a 60 Hz display.
+    /// - `gravity` [0, -9.81, 0] m/s²: Earth's, with +Y up.
+    /// - `iterations` 3 with `substeps` 3: nine solver sweeps per step, about
+    ///   the contract's suggested 8, spent as three substeps of three
+    ///   (Macklin et al. 2019, "Small Steps"): gravity's push per substep is
+    ///   a ninth, and contacts are found once per step, so the cost is about
+    ///   that of 8 sweeps in one substep.
+    /// - `relaxation` 0.5: corrects half of each error per sweep, which
+    ///   converges steadily without overshooting when constraints fight.
+    ///   Measured on piles placed imperfectly (every box shifted up to 1 cm
+    ///   and turned up to 1 degree), 10 s at 60 Hz: no box of a 20-row
+    ///   pyramid moves more than 3.9 cm with 3 x 3, 5.6 m with 4 x 2, and
+    ///   it collapses with 2 x 4; c_r 0.65 made a perfect 10-row pyramid
+    ///   creep 4.5 cm (1.1 cm at 0.5).
+    /// - dampings 0: no energy is removed unless a scene asks for it.
+    /// - `restitution` 0.2: contacts bounce a little, as wood or plastic do.
+    /// - `friction` 0.5: a common everyday value (wood on wood).
+    /// - `sleeping` on: Jacobi sweeps converge slowly through a pile several
+    ///   bodies deep, and what they leave over creeps (1000 cubes dropped
+    ///   in four layers: a quarter still move 1 cm a second after 15 s with
+    ///   sleeping off, none with it on). Box2D, rapier and PhysX sleep too.
+    fn default() -> Self {
+        Settings {
+            dt: 1.0 / 60.0,
+            gravity: [0.0, -9.81, 0.0],
+            iterations: 3,
+            relaxation: 0.5,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            restitution: 0.2,
+            friction: 0.5,
+            substeps: 3,
+            sleeping: true,
+        }
+    }
+}
+
+/// An infinite static plane `y = height` with normal +Y.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ground {
+    /// Height of the plane in metres.
+    pub height: f32,
+}
+
+/// The collision and mass shape of a body, in the body's local frame and
+/// centred on its centre of mass.
+///
+/// In JSON: `{"type": "box", "half_extents": [x, y, z]}` or
+/// `{"type": "sphere", "radius": r}`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A box with the given half extents in metres (all > 0).
+    Box { half_extents: [f32; 3] },
+    /// A sphere with the given radius in metres (> 0).
+    Sphere { radius: f32 },
+}
+
+impl Shape {
+    /// Volume in m³.
+    pub fn volume(&self) -> f32 {
+        self.volume_f64() as f32
+    }
+
+    fn volume_f64(&self) -> f64 {
+        match *self {
+            Shape::Box { half_extents: [a, b, c] } => 8.0 * a as f64 * b as f64 * c as f64,
+            Shape::Sphere { radius } => {
+                let r = radius as f64;
+                4.0 / 3.0 * std::f64::consts::PI * r * r * r
+            }
+        }
+    }
+
+    /// Radius in metres of the smallest sphere around the centre that holds
+    /// the shape.
+    pub fn bounding_radius(&self) -> f32 {
+        match *self {
+            Shape::Box { half_extents: [a, b, c] } => {
+                let (a, b, c) = (a as f64, b as f64, c as f64);
+                (a * a + b * b + c * c).sqrt() as f32
+            }
+            Shape::Sphere { radius } => radius,
+        }
+    }
+
+    /// Principal moments of inertia (kg·m²) of a solid shape of mass `mass`,
+    /// in the body frame, computed in f64.
+    fn inertia_f64(&self, mass: f32) -> [f64; 3] {
+        let m = mass as f64;
+        match *self {
+            Shape::Box { half_extents: [a, b, c] } => {
+                let (a2, b2, c2) = ((a as f64).powi(2), (b as f64).powi(2), (c as f64).powi(2));
+                [m / 3.0 * (b2 + c2), m / 3.0 * (a2 + c2), m / 3.0 * (a2 + b2)]
+            }
+            Shape::Sphere { radius } => {
+                let i = 0.4 * m * (radius as f64).powi(2);
+                [i, i, i]
+            }
+        }
+    }
+}
+
+/// One rigid body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Shape, centred on the body's centre of mass.
+    pub shape: Shape,
+    /// Position of the centre of mass in metres, world frame.
+    pub position: [f32; 3],
+    /// Rotation from body to world frame, `[x, y, z, w]`. Loading normalises
+    /// it; scenes built in Rust should give a unit quaternion.
+    pub orientation: [f32; 4],
+    /// Initial velocity of the centre of mass in m/s, world frame.
+    pub linear_velocity: [f32; 3],
+    /// Initial angular velocity in rad/s, world frame.
+    pub angular_velocity: [f32; 3],
+    /// Mass in kg: the file's `mass`, or its `density` (default 1000 kg/m³)
+    /// times the shape's volume. Fixed bodies keep the resolved value too;
+    /// [`Body::inverse_mass`] is what makes them immovable.
+    pub mass: f32,
+    /// An immovable body (infinite mass): its inverse mass and inverse
+    /// inertia are zero.
+    pub fixed: bool,
+    /// Overrides [`Settings::restitution`] for contacts of this body.
+    pub restitution: Option<f32>,
+    /// Overrides [`Settings::friction`] for contacts of this body.
+    pub friction: Option<f32>,
+}
+
+impl Body {
+    /// A movable body at rest with identity orientation and the default
+    /// density of 1000 kg/m³.
+    pub fn new(shape: Shape, position: [f32; 3]) -> Body {
+        let mass = (DEFAULT_DENSITY as f64 * shape.volume_f64()) as f32;
+        Body {
+            shape,
+            position,
+            orientation: IDENTITY_ORIENTATION,
+            linear_velocity: [0.0; 3],
+            angular_velocity: [0.0; 3],
+            mass,
+            fixed: false,
+            restitution: None,
+            friction: None,
+        }
+    }
+
+    /// 1 / mass in 1/kg; 0 for a fixed body.
+    pub fn inverse_mass(&self) -> f32 {
+        if self.fixed {
+            0.0
+        } else {
+            (1.0 / self.mass as f64) as f32
+        }
+    }
+
+    /// Inverse principal moments of inertia in 1/(kg·m²), in the body frame
+    /// (the diagonal of the inverse inertia tensor); zeros for a fixed body.
+    ///
+    /// Solid box with half extents a, b, c: I = m/3 · (b² + c², a² + c²,
+    /// a² + b²). Solid sphere: I = 2/5 · m · r² about every axis.
+    pub fn inverse_inertia(&self) -> [f32; 3] {
+        if self.fixed {
+            return [0.0; 3];
+        }
+        let i = self.shape.inertia_f64(self.mass);
+        [(1.0 / i[0]) as f32, (1.0 / i[1]) as f32, (1.0 / i[2]) as f32]
+    }
+
+    /// Radius in metres of the smallest sphere around the centre of mass
+    /// that holds the body.
+    pub fn bounding_radius(&self) -> f32 {
+        self.shape.bounding_radius()
+    }
+}
+
+/// A ball joint: pins `anchors[0]` of `bodies[0]` to `anchors[1]` of
+/// `bodies[1]`.
+///
+/// In JSON: `{"type": "ball", "bodies": [a, b], "anchors": [[..], [..]]}`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    /// Indices into [`Scene::bodies`]; [`WORLD`] (-1) stands for the world.
+    /// The two must differ and at most one may be the world.
+    pub bodies: [i32; 2],
+    /// Anchor points in metres: in the body's local frame, or in world
+    /// coordinates for the world side.
+    pub anchors: [[f32; 3]; 2],
+}
+
+/// A fixed camera for rendering frames (extension to the contract).
+///
+/// In JSON: `{"position": [..], "target": [..], "fov_y": 0.785}`, where
+/// `fov_y` (radians, like every angle of the contract) is optional.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position in metres, world frame.
+    pub position: [f32; 3],
+    /// The point looked at, world frame. Must differ from `position`.
+    pub target: [f32; 3],
+    /// Vertical field of view in radians, in (0, pi); default `DEFAULT_FOV_Y`.
+    pub fov_y: f32,
+}
+
+/// Why a scene could not be loaded. The message fits on one line: the
+/// offending field's path, then why.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene file could not be read (missing, unreadable, not UTF-8).
+    #[error("{}: cannot read scene file: {}", one_line(&.path.display().to_string()), one_line(&.error.to_string()))]
+    Io {
+        /// The file that was being read.
+        path: PathBuf,
+        /// What went wrong.
+        error: std::io::Error,
+    },
+    /// The text is not valid JSON.
+    #[error("line {line}, column {column}: malformed JSON: {message}")]
+    Syntax {
+        /// 1-based line of the error.
+        line: usize,
+        /// 1-based column of the error (0 when the text is empty).
+        column: usize,
+        /// What the parser expected, and in which field if known.
+        message: String,
+    },
+    /// A field is unknown, missing, of the wrong type or has a bad value.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// Path of the field, e.g. `bodies[3].shape.half_extents[1]`.
+        field: String,
+        /// Why it is refused, including the offending value.
+        message: String,
+    },
+}
+
+impl SceneError {
+    /// The path of the offending field, when the error has one.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            SceneError::Invalid { field, .. } => Some(field),
+            _ => None,
+        }
+    }
+
+    fn invalid(field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid { field: field.into(), message: message.into() }
+    }
+
+    fn missing(field: impl Into<String>) -> SceneError {
+        SceneError::invalid(field, "is required but missing")
+    }
+}
+
+mod load;
+#[cfg(test)]
+mod tests;
+mod validate;
+mod write;
+
+use load::*;
+use validate::*;
+
+pub(crate) use load::{classify_json_error, one_line, path_string, text_problem, JsonFault, Obj};
+pub use validate::{spin_problem, MIN_BOUNDING_RADIUS};

@@ -1,0 +1,306 @@
+//! Checking a scene: every value, with the field it came from.
+
+use super::*;
+
+impl Scene {
+    /// Checks every value of the scene, returning the first problem found.
+    ///
+    /// [`Scene::from_json_str`] calls this; call it yourself on scenes built
+    /// in Rust.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        validate_settings(&self.settings)?;
+        if let Some(ground) = &self.ground {
+            check_finite(ground.height, "ground.height")?;
+        }
+        for (i, body) in self.bodies.iter().enumerate() {
+            validate_body(body, &format!("bodies[{i}]"), &self.settings)?;
+        }
+        for (i, joint) in self.joints.iter().enumerate() {
+            validate_joint(joint, self.bodies.len(), &format!("joints[{i}]"))?;
+        }
+        if self.ground.is_some() {
+            check_sink(&self.settings, &self.bodies)?;
+        }
+        if let Some(camera) = &self.camera {
+            validate_camera(camera)?;
+        }
+        Ok(())
+    }
+}
+
+pub(super) fn validate_settings(s: &Settings) -> Result<(), SceneError> {
+    check_positive(s.dt, "settings.dt")?;
+    check_all_finite(&s.gravity, "settings.gravity")?;
+    if !(1..=MAX_ITERATIONS).contains(&s.iterations) {
+        return Err(SceneError::invalid(
+            "settings.iterations",
+            format!("must be between 1 and {MAX_ITERATIONS}, got {}", s.iterations),
+        ));
+    }
+    check_finite(s.relaxation, "settings.relaxation")?;
+    if !(s.relaxation > 0.0 && s.relaxation <= 1.0) {
+        return Err(SceneError::invalid("settings.relaxation", format!("must be in (0, 1], got {}", show(s.relaxation))));
+    }
+    check_damping(s.linear_damping, "settings.linear_damping")?;
+    check_damping(s.angular_damping, "settings.angular_damping")?;
+    check_restitution(s.restitution, "settings.restitution")?;
+    check_friction(s.friction, "settings.friction")?;
+    if !(1..=MAX_SUBSTEPS).contains(&s.substeps) {
+        return Err(SceneError::invalid("settings.substeps", format!("must be between 1 and {MAX_SUBSTEPS}, got {}", s.substeps)));
+    }
+    Ok(())
+}
+
+/// Refuses a step so long that bodies would rest visibly inside the ground.
+/// Gravity moves a body |g| h^2 into whatever it rests on every substep of
+/// h, and `iterations` Jacobi sweeps relaxed by c_r take back all but
+/// (1 - c_r)^iterations of it, so that much stays inside, every substep,
+/// and a body rests (and falls asleep) there: measured, unit cubes came to
+/// rest 6 mm inside the ground at dt 0.2 s, 39 mm at 0.5 s and 156 mm at
+/// 1 s (3 substeps, 3 sweeps, c_r 0.5), as the formula says. The limit is a
+/// tenth of the smallest moving body's bounding radius.
+pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError> {
+    let Some(smallest) = bodies.iter().filter(|b| !b.fixed).map(|b| b.bounding_radius()).reduce(f32::min) else {
+        return Ok(());
+    };
+    let h = s.dt as f64 / s.substeps as f64;
+    let g = s.gravity.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+    let left = (1.0 - s.relaxation as f64).powi(s.iterations as i32);
+    let sink = left * g * h * h;
+    let limit = 0.1 * smallest as f64;
+    if sink <= limit {
+        return Ok(());
+    }
+    // blame the setting the user moved off its default
+    let field = if s.dt != Settings::default().dt || g <= 9.81 { "settings.dt" } else { "settings.gravity" };
+    Err(SceneError::invalid(
+        field,
+        format!(
+            "a step this long lets bodies rest inside the ground: gravity ({g:.3e} m/s^2) moves a body {:.3e} m a substep \
+             (dt {} s / {} substeps) and {} sweeps at relaxation {} leave {sink:.3e} m of that inside, more than a tenth of \
+             the smallest body's bounding radius ({limit:.3e} m); lower dt or gravity, or raise settings.substeps",
+            g * h * h,
+            show(s.dt),
+            s.substeps,
+            s.iterations,
+            show(s.relaxation)
+        ),
+    ))
+}
+
+/// Why an angular velocity `w` (rad/s) is absurd for substeps of `h` s (0:
+/// any), if it is: faster than `world::MAX_SPIN`, or turning more than
+/// `world::MAX_TURN` in one substep, which a pose pair cannot hold (the
+/// numerical-fault check of integrate.wgsl would stop the body).
+pub fn spin_problem(w: [f32; 3], h: f32) -> Option<String> {
+    use crate::world::{MAX_SPIN, MAX_TURN};
+    let rate = w.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+    if rate > MAX_SPIN as f64 {
+        return Some(format!("spins at {rate:.4e} rad/s; at most {MAX_SPIN:e} rad/s is sane"));
+    }
+    let turn = rate * h as f64;
+    if turn > MAX_TURN as f64 {
+        return Some(format!(
+            "spins at {rate:.1} rad/s, {turn:.2} rad per substep of {h:.3e} s; a body turns at most {MAX_TURN} rad \
+             in one substep (a pose pair holds under half a turn): lower the spin, or raise settings.substeps or lower dt"
+        ));
+    }
+    None
+}
+
+pub(super) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Result<(), SceneError> {
+    check_shape(&body.shape, &format!("{path}.shape"))?;
+    check_all_finite(&body.position, &format!("{path}.position"))?;
+    check_orientation(body.orientation, &format!("{path}.orientation"))?;
+    check_all_finite(&body.linear_velocity, &format!("{path}.linear_velocity"))?;
+    check_all_finite(&body.angular_velocity, &format!("{path}.angular_velocity"))?;
+    if !body.fixed {
+        if let Some(why) = spin_problem(body.angular_velocity, settings.dt / settings.substeps as f32) {
+            return Err(SceneError::invalid(format!("{path}.angular_velocity"), why));
+        }
+    }
+    check_positive(body.mass, &format!("{path}.mass"))?;
+    if let Some(restitution) = body.restitution {
+        check_restitution(restitution, &format!("{path}.restitution"))?;
+    }
+    if let Some(friction) = body.friction {
+        check_friction(friction, &format!("{path}.friction"))?;
+    }
+    // A valid but extreme mass and size can still overflow f32 in the
+    // inverse mass or inertia; the solver needs those finite and positive.
+    if !body.fixed {
+        let inverse_mass = body.inverse_mass();
+        let inverse_inertia = body.inverse_inertia();
+        let usable = |x: f32| x.is_finite() && x > 0.0;
+        if !usable(inverse_mass) || !inverse_inertia.iter().all(|&x| usable(x)) {
+            return Err(SceneError::invalid(
+                format!("{path}.mass"),
+                format!(
+                    "mass {} kg with this shape gives inverse mass {} and inverse inertia {:?}, which are not positive finite numbers",
+                    show(body.mass),
+                    show(inverse_mass),
+                    inverse_inertia
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Result<(), SceneError> {
+    for (k, &index) in joint.bodies.iter().enumerate() {
+        let in_range = index == WORLD || (index >= 0 && (index as i64) < body_count as i64);
+        if !in_range {
+            let valid = if body_count == 0 {
+                "only -1 (the world), as the scene has no bodies".to_string()
+            } else {
+                format!("0..={} or -1 for the world", body_count - 1)
+            };
+            return Err(SceneError::invalid(
+                format!("{path}.bodies[{k}]"),
+                format!("names body {index}, but the scene has {body_count} bodies (valid: {valid})"),
+            ));
+        }
+    }
+    let [a, b] = joint.bodies;
+    if a == b {
+        let message = if a == WORLD {
+            "both sides are the world (-1); a joint needs at least one body".to_string()
+        } else {
+            format!("joins body {a} to itself; the two sides must differ")
+        };
+        return Err(SceneError::invalid(format!("{path}.bodies"), message));
+    }
+    for (k, anchor) in joint.anchors.iter().enumerate() {
+        check_all_finite(anchor, &format!("{path}.anchors[{k}]"))?;
+    }
+    Ok(())
+}
+
+pub(super) fn validate_camera(camera: &Camera) -> Result<(), SceneError> {
+    check_all_finite(&camera.position, "camera.position")?;
+    check_all_finite(&camera.target, "camera.target")?;
+    if camera.position == camera.target {
+        return Err(SceneError::invalid(
+            "camera.target",
+            format!("must differ from camera.position, both are {:?}", camera.position),
+        ));
+    }
+    let fov = camera.fov_y;
+    check_finite(fov, "camera.fov_y")?;
+    if !(fov > 0.0 && fov < std::f32::consts::PI) {
+        return Err(SceneError::invalid("camera.fov_y", format!("must be in (0, pi) radians, got {}", show(fov))));
+    }
+    Ok(())
+}
+
+/// The smallest bounding radius (m) a body may have. Measured on lavapipe,
+/// dropped from 1 m with restitution 0.5 at three tilts and the default
+/// settings: spheres of radius 6 mm and less sank more than their radius
+/// into the ground and spun up to 270-320 rad/s from rounding (their inverse
+/// inertia is huge, so a lever arm off by a rounding error turns them), a
+/// cube of half extent 5 mm sank 1.1 cm, and a tilted 2.5 mm cube bounced to
+/// 0.34 m where 0.25 m is the most restitution allows; from 7.5 mm up every
+/// one landed, bounced at most 0.25 m and stopped turning.
+pub const MIN_BOUNDING_RADIUS: f32 = 0.01;
+
+pub(super) fn check_shape(shape: &Shape, path: &str) -> Result<(), SceneError> {
+    let field = match *shape {
+        Shape::Box { half_extents } => {
+            for (k, &h) in half_extents.iter().enumerate() {
+                check_positive(h, &format!("{path}.half_extents[{k}]"))?;
+            }
+            "half_extents"
+        }
+        Shape::Sphere { radius } => {
+            check_positive(radius, &format!("{path}.radius"))?;
+            "radius"
+        }
+    };
+    let r = shape.bounding_radius();
+    if r < MIN_BOUNDING_RADIUS {
+        return Err(SceneError::invalid(
+            format!("{path}.{field}"),
+            format!(
+                "the body is too small: its bounding radius is {} m, the solver handles {} m and up \
+                 (smaller bodies sink into what they land on and spin up from rounding)",
+                show(r),
+                show(MIN_BOUNDING_RADIUS)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+pub(super) fn check_orientation(q: [f32; 4], path: &str) -> Result<(), SceneError> {
+    check_all_finite(&q, path)?;
+    let norm = quaternion_norm(q);
+    if norm <= MIN_ORIENTATION_NORM {
+        return Err(SceneError::invalid(
+            path,
+            format!("must be a non-zero quaternion [x, y, z, w], got {q:?} (length {})", show(norm as f32)),
+        ));
+    }
+    Ok(())
+}
+
+/// A number for an error message: `-1` rather than `-1.0`, `1e38` rather
+/// than 39 digits.
+pub(super) fn show(x: f32) -> String {
+    let text = format!("{x:?}");
+    match text.strip_suffix(".0") {
+        Some(whole) => whole.to_string(),
+        None => text,
+    }
+}
+
+pub(super) fn check_finite(x: f32, path: &str) -> Result<(), SceneError> {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be a finite number, got {}", show(x))))
+    }
+}
+
+pub(super) fn check_all_finite(values: &[f32], path: &str) -> Result<(), SceneError> {
+    for (k, &x) in values.iter().enumerate() {
+        check_finite(x, &format!("{path}[{k}]"))?;
+    }
+    Ok(())
+}
+
+pub(super) fn check_positive(x: f32, path: &str) -> Result<(), SceneError> {
+    check_finite(x, path)?;
+    if x > 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be positive, got {}", show(x))))
+    }
+}
+
+pub(super) fn check_damping(x: f32, path: &str) -> Result<(), SceneError> {
+    check_finite(x, path)?;
+    if (0.0..1.0).contains(&x) {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be in [0, 1), got {}", show(x))))
+    }
+}
+
+pub(super) fn check_restitution(x: f32, path: &str) -> Result<(), SceneError> {
+    check_finite(x, path)?;
+    if (0.0..=1.0).contains(&x) {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be in [0, 1], got {}", show(x))))
+    }
+}
+
+pub(super) fn check_friction(x: f32, path: &str) -> Result<(), SceneError> {
+    check_finite(x, path)?;
+    if x >= 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(path, format!("must be >= 0, got {}", show(x))))
+    }
+}
