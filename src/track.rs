@@ -456,7 +456,7 @@ fn at_least(v: f32, path: &str, low: f32, or_equal: bool) -> Result<(), TrackErr
 }
 
 // ---------------------------------------------------------------------------
-// The file's raw form (as in scene.rs: every field optional so that a missing
+// The file's raw form (as in scene/load.rs: every field optional so that a missing
 // one is named, lists as Vec so that a wrong length is named)
 // ---------------------------------------------------------------------------
 
@@ -615,7 +615,7 @@ impl RawEvent {
 }
 
 // ---------------------------------------------------------------------------
-// JSON errors, as scene.rs reports them
+// JSON errors, as scene/load.rs reports them
 // ---------------------------------------------------------------------------
 
 fn json_error(field: Option<String>, inner: serde_json::Error) -> TrackError {
