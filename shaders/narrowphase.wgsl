@@ -117,13 +117,12 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
 // A slot of the manifold pool for bodies a and b (b may be GROUND), listed
 // in both bodies' lists (in the order the slots are taken; contact_lists
 // sorts them), or NONE when the pool is full (counted in status[4] all the
-// same, so the host grows it). A face contact left for clipping (`to_clip`)
+// same, so the host grows it; contact_lists keeps the most in status[5]). A face contact left for clipping (`to_clip`)
 // takes the next slot from the top of the pool, any other the next from the
 // bottom, so narrowphase_clip runs over the top run alone; the two never
 // meet, as status[4] hands out no more tickets than the pool has slots.
 fn new_manifold(a: u32, b: u32, to_clip: bool) -> u32 {
     let ticket = atomicAdd(&status[4], 1u);
-    atomicMax(&status[5], ticket + 1u);
     if (ticket >= arrayLength(&manifolds)) {
         return NONE;
     }
@@ -233,6 +232,9 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i == 0u) {
+        // the most manifolds any step wanted (status[4] counts the slots
+        // the pool could not give too)
+        atomicMax(&status[5], atomicLoad(&status[4]));
         let used = manifolds_used();
         atomicStore(&status[12], (used + WORKGROUP - 1u) / WORKGROUP);
         atomicStore(&status[13], 1u);
