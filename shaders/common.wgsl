@@ -1,7 +1,7 @@
 // Types and maths that bind nothing, shared by every compute pass and the
 // renderer: the body layout, the per-step parameters, the contact records
 // and the quaternion helpers. Every struct here has a #[repr(C)] twin in
-// src/gpu/types.rs, checked member by member by tests/layouts.rs. The
+// src/gpu/types.rs, checked member by member by tests/gpu/layouts.rs. The
 // constants shared with Rust (NONE, GROUND, WORLD, HELD, MAX_POINTS,
 // SHAPE_*, FLAG_FIXED, GRID_BODY, LARGE_BODY, WORKGROUP, SCAN_BLOCK, the
 // fault codes and limits) are not written here: src/gpu/shaders.rs writes

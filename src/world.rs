@@ -635,7 +635,7 @@ impl World {
 
     /// Runs `stages` alone, in order, each as a step's first substep runs it,
     /// and leaves the step count as it was: a way to check one kernel
-    /// against a known answer (tests/kernels.rs), not a way to simulate.
+    /// against a known answer (tests/gpu/kernels.rs), not a way to simulate.
     #[doc(hidden)]
     pub fn run_stages(&mut self, stages: &[Stage]) -> Result<(), Error> {
         self.write_params(&[self.settings.dt], self.settings.substeps as usize);

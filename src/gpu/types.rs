@@ -1,5 +1,5 @@
 //! Host twins of the structs in `shaders/common.wgsl`. Each is `#[repr(C)]`
-//! with its padding written out; `tests/layouts.rs` checks every member's
+//! with its padding written out; `tests/gpu/layouts.rs` checks every member's
 //! name and offset and the size against the WGSL.
 
 use bytemuck::{Pod, Zeroable};

@@ -202,7 +202,7 @@ impl Stage {
 
     /// The buffers the stage's entry point reads and writes: every buffer
     /// its code can touch, as naga's analysis of the entry point finds it
-    /// (`tests/shaders.rs` checks both lists against it), so a branch not
+    /// (`tests/gpu/shaders.rs` checks both lists against it), so a branch not
     /// taken counts (the pair walks share one walk that writes in
     /// `pairs_write` and counts in `pairs_count`; the scan passes hold the
     /// grid's case and the pairs' both). An atomic is a read and a write.

@@ -10,7 +10,7 @@
 //! budgets are reset by the integration pass), and the velocities the
 //! restitution pass compares against are written by that step's integration.
 //! Restoring the poses and `dt_prev` therefore continues bit for bit as the
-//! run the snapshot was taken from (tests/snapshot.rs checks it).
+//! run the snapshot was taken from (tests/gpu/snapshot.rs checks it).
 //!
 //! A snapshot names the scene it belongs to by a hash of the world's static
 //! data (settings, ground, grid, the bodies' shapes, masses and materials,

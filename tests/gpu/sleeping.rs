@@ -4,9 +4,7 @@
 //! moves faster than 20 cm/s, and every body wakes after any input or edit.
 //! Bodies with joints never sleep; free-flying bodies never sleep.
 
-mod common;
-
-use common::{v3, world};
+use crate::common::{v3, world};
 use verlet::scene::{Joint, WORLD};
 use verlet::scenes::{self, box_body, sphere_body};
 

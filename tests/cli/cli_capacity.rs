@@ -1,15 +1,13 @@
 //! A scene beyond the adapter's limits (issue 7, part 1) given to the
 //! command line: a non-zero exit and a one-line reason, no panic.
 
-mod common;
-
 use std::process::Command;
 
 use verlet::world::max_bodies;
 
 #[test]
 fn verlet_run_refuses_a_scene_beyond_the_adapters_limits() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let count = max_bodies(&gpu) + 1;
     let output = Command::new(env!("CARGO_BIN_EXE_verlet"))
         .args(["run", "--builtin", "cubes", "--count", &count.to_string(), "--steps", "1"])

@@ -5,13 +5,11 @@
 //! work was done, not a speed). Every child runs under a 4 GB address-space
 //! cap, so a regression cannot take the machine's memory.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-use common::{no_adapter, temp_path};
+use crate::common::{no_adapter, temp_path};
 use verlet::scene::Scene;
 use verlet::scenes;
 
@@ -135,7 +133,7 @@ fn body_counts_are_worked_out_exactly_without_building() {
 
 #[test]
 fn a_count_beyond_the_adapter_is_refused_before_the_scene_is_built() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let max = verlet::world::max_bodies(&gpu);
     let count = (max + 1).to_string();
     let args = ["run", "--builtin", "chain", "--count", &count, "--steps", "1"];
@@ -370,7 +368,7 @@ fn a_body_turning_more_than_a_substep_holds_is_faulted() {
     let mut scene = scenes::stack(0);
     scene.settings.gravity = [0.0; 3];
     scene.bodies = (0..3).map(|k| scenes::box_body([0.5; 3], [10.0 * k as f32, 5.0, 0.0])).collect();
-    let Some(mut world) = common::world(&scene) else { return };
+    let Some(mut world) = crate::common::world(&scene) else { return };
     world.step(2).unwrap();
     // turn body 1's previous rotation 3.1 rad away from its current one
     let mut state = world.read_raw().unwrap()[1];
@@ -454,7 +452,7 @@ fn a_bad_wgpu_backend_names_the_variable_and_its_values() {
 #[test]
 fn bench_says_aloud_what_it_skips() {
     assert_refused_quickly(&["bench", "--cases", ",,,"], &["--cases", "no case"]);
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let count = verlet::world::max_bodies(&gpu) + 1;
     let case = format!("chain:{count}");
     let (out, _) = capped(&["bench", "--cases", &format!("{case},,"), "--steps", "1", "--reps", "1", "--profile-steps", "0"]);
@@ -551,15 +549,15 @@ fn two_bodies_placed_in_one_spot_separate_no_faster_than_promised() {
         scene.ground = None;
         scene.settings.gravity = [0.0; 3];
         scene.bodies = vec![cube(), second];
-        let Some(mut w) = common::world(&scene) else { return };
+        let Some(mut w) = crate::common::world(&scene) else { return };
         let mut fastest = 0.0f32;
         for _ in 0..120 {
             w.step(1).unwrap();
             let state = w.read_state().unwrap();
-            fastest = state.iter().map(|b| common::v3(b.linear_velocity).length()).fold(fastest, f32::max);
+            fastest = state.iter().map(|b| crate::common::v3(b.linear_velocity).length()).fold(fastest, f32::max);
         }
         let state = w.read_state().unwrap();
-        let apart = (common::v3(state[0].position) - common::v3(state[1].position)).length();
+        let apart = (crate::common::v3(state[0].position) - crate::common::v3(state[1].position)).length();
         eprintln!("{name}: fastest {fastest:.2} m/s, centres {apart:.3} m apart after 2 s");
         assert!(fastest <= 3.0, "{name}: separated at {fastest} m/s");
         assert!(apart > 1.0, "{name}: still overlapping after 2 s, centres {apart} m apart");

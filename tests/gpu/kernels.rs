@@ -2,9 +2,7 @@
 //! (`World::run_stages`) and checks what one kernel wrote against what it
 //! must write, so a regression names its pass.
 
-mod common;
-
-use common::world;
+use crate::common::world;
 use glam::{Quat, Vec3};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::step::{Buffer, Stage};

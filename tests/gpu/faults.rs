@@ -4,8 +4,6 @@
 //! stopped at its last sane pose, the others go on untouched, and
 //! `verlet run` fails naming body and step.
 
-mod common;
-
 use std::process::Command;
 
 use verlet::gpu::types::BodyState;
@@ -29,8 +27,8 @@ fn finite(s: &BodyState) -> bool {
 
 /// A state the host sees as sane: finite, near, not fast.
 fn sane(s: &BodyState, dt: f32) -> bool {
-    let p = common::v3(s.pos);
-    finite(s) && p.length() < 1e3 && common::v3(s.disp).length() / dt < 100.0
+    let p = crate::common::v3(s.pos);
+    finite(s) && p.length() < 1e3 && crate::common::v3(s.disp).length() / dt < 100.0
 }
 
 #[test]
@@ -39,8 +37,8 @@ fn absurd_initial_velocity_is_flagged_and_the_others_are_untouched() {
     bad.bodies[2].linear_velocity = [1e5, 0.0, 0.0];
     // the scene loader takes it: finite is all it asks
     let bad = Scene::from_json_str(&bad.to_json()).expect("the loader accepts 1e5 m/s");
-    let Some(mut world) = common::world(&bad) else { return };
-    let mut clean = common::world(&row()).unwrap();
+    let Some(mut world) = crate::common::world(&bad) else { return };
+    let mut clean = crate::common::world(&row()).unwrap();
     assert_eq!(world.faults().unwrap(), None, "no fault before any step");
     world.step(120).unwrap();
     clean.step(120).unwrap();
@@ -71,7 +69,7 @@ fn absurd_initial_velocity_is_flagged_and_the_others_are_untouched() {
 
 #[test]
 fn the_first_fault_is_kept_with_its_own_step() {
-    let Some(mut world) = common::world(&row()) else { return };
+    let Some(mut world) = crate::common::world(&row()) else { return };
     world.step(10).unwrap();
     assert_eq!(world.faults().unwrap(), None);
     // two bodies go wrong before step 10, a lower one before step 20
@@ -98,8 +96,8 @@ fn the_first_fault_is_kept_with_its_own_step() {
 
 #[test]
 fn a_nan_is_flagged_and_the_body_parked_at_its_finite_coordinates() {
-    let Some(mut world) = common::world(&row()) else { return };
-    let mut clean = common::world(&row()).unwrap();
+    let Some(mut world) = crate::common::world(&row()) else { return };
+    let mut clean = crate::common::world(&row()).unwrap();
     world.step(5).unwrap();
     clean.step(5).unwrap();
     // poison body 3's current position directly in the state buffer
@@ -127,7 +125,7 @@ fn a_nan_is_flagged_and_the_body_parked_at_its_finite_coordinates() {
 
 #[test]
 fn a_clean_run_of_1000_steps_reports_no_fault() {
-    let Some(mut world) = common::world(&scenes::cubes(100, 3)) else { return };
+    let Some(mut world) = crate::common::world(&scenes::cubes(100, 3)) else { return };
     world.step(1000).unwrap();
     assert_eq!(world.faults().unwrap(), None);
     let bodies = world.read_state().expect("no fault, no divergence");
@@ -142,7 +140,7 @@ fn write(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
 
 #[test]
 fn the_command_line_fails_naming_body_and_step() {
-    if common::gpu().is_none() {
+    if crate::common::gpu().is_none() {
         return;
     }
     let dir = std::env::temp_dir().join(format!("verlet-faults-{}", std::process::id()));

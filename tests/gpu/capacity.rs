@@ -1,8 +1,6 @@
 //! Memory and capacity (issue 3, part 6): a scene beyond the adapter's limits
 //! is refused before any allocation; the pair list grows for a crowded scene.
 
-mod common;
-
 use glam::Vec3;
 use verlet::scenes::{self, box_body, sphere_body};
 use verlet::world::max_bodies;
@@ -10,7 +8,7 @@ use verlet::{Error, World};
 
 #[test]
 fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let max = max_bodies(&gpu) as usize;
     let mut scene = scenes::stack(0);
     scene.bodies = (0..max + 1).map(|k| box_body([0.5; 3], [2.0 * (k % 1000) as f32, 0.5, 2.0 * (k / 1000) as f32])).collect();
@@ -40,7 +38,7 @@ fn the_pair_pools_grow_for_a_crowded_scene() {
         scene.bodies.push(sphere_body(0.5, at.to_array()));
     }
     let n = scene.bodies.len();
-    let Some(mut w) = common::world(&scene) else { return };
+    let Some(mut w) = crate::common::world(&scene) else { return };
     let before = w.contact_report().unwrap();
     w.step(1).unwrap();
     let first = w.contact_report().unwrap();
@@ -107,7 +105,7 @@ fn a_body_that_owns_more_pairs_than_its_scratch_room_lists_them_all() {
     for k in 0..40 {
         scene.bodies.push(sphere_body(0.3, [10.0 + 2.0 * k as f32, 0.5, 0.5]));
     }
-    let Some(mut w) = common::world(&scene) else { return };
+    let Some(mut w) = crate::common::world(&scene) else { return };
     let made = w.contact_report().unwrap();
     assert!(2 * made.pair_capacity / (scene.bodies.len() as u32) < ring as u32, "the room holds every pair: {made:?}");
     w.step(1).unwrap();

@@ -2,8 +2,6 @@
 //! hashes to a pinned value on lavapipe, and two separate processes write
 //! byte-identical state files.
 
-mod common;
-
 use std::process::Command;
 
 use verlet::{scenes, World};
@@ -47,7 +45,7 @@ fn canonical_hash(world: &mut World) -> u64 {
 
 #[test]
 fn canonical_scene_hash_is_pinned() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let scene = scenes::cubes(200, 1);
     let hash = canonical_hash(&mut World::with_gpu(gpu.clone(), &scene).unwrap());
     // The same process, a second world: the same bits.
@@ -67,7 +65,7 @@ fn canonical_scene_hash_is_pinned() {
 
 #[test]
 fn two_processes_write_identical_state_files() {
-    if common::gpu().is_none() {
+    if crate::common::gpu().is_none() {
         return;
     }
     let dir = std::env::temp_dir().join(format!("verlet-determinism-{}", std::process::id()));

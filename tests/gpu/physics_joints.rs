@@ -1,9 +1,7 @@
 //! Ball joints (issue 4): a chain that swings and comes to rest, a pendulum
 //! with the compound-pendulum period, a loaded bridge, ragdolls on a pile.
 
-mod common;
-
-use common::{quat, v3, world};
+use crate::common::{quat, v3, world};
 use glam::{Quat, Vec3};
 use verlet::scenes::{self, box_body};
 use verlet::world::joint_gaps;

@@ -1,9 +1,7 @@
 //! User input between steps (issue 8): impulses, poses and velocities,
 //! explosions, fixed/dynamic switching, and the errors of bad arguments.
 
-mod common;
-
-use common::{quat, v3, world};
+use crate::common::{quat, v3, world};
 use glam::{DQuat, DVec3, Quat};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::world::input::{BodyInput, Point};

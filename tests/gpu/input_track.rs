@@ -3,8 +3,6 @@
 //! before, `verlet run --input`, and the built-in `blast` scene with its
 //! default track.
 
-mod common;
-
 use verlet::scenes::{self, sphere_body};
 use verlet::track::{Action, Event, Track, TrackError};
 use verlet::world::input::Wind;
@@ -181,7 +179,7 @@ fn an_impulse_event_at_half_a_second_acts_at_step_30_and_not_before() {
     let mass = scene.bodies[0].mass;
     let track = Track::from_json_str(r#"{"events": [{"t": 0.5, "impulse": {"body": 0, "impulse": [0, 0, 100]}}]}"#).unwrap();
     track.check(scene.bodies.len()).unwrap();
-    let Some(mut world) = common::world(&scene) else { return };
+    let Some(mut world) = crate::common::world(&scene) else { return };
     let mut v_prev = world.read_state().unwrap()[0].linear_velocity;
     for step in 0..40u64 {
         assert_eq!(world.step_count(), step);
@@ -207,7 +205,7 @@ fn an_impulse_event_at_half_a_second_acts_at_step_30_and_not_before() {
 fn a_wind_event_blows_over_its_duration_only() {
     let scene = free_scene();
     let track = Track::from_json_str(r#"{"events": [{"t": 0.1, "wind": {"velocity": [0, 0, 20], "duration": 0.25}}]}"#).unwrap();
-    let Some(mut world) = common::world(&scene) else { return };
+    let Some(mut world) = crate::common::world(&scene) else { return };
     let mut v_prev = world.read_state().unwrap()[0].linear_velocity;
     let mut pushed = Vec::new();
     for step in 0..30u64 {
@@ -227,7 +225,7 @@ fn a_wind_event_blows_over_its_duration_only() {
 // The command line
 // ---------------------------------------------------------------------------
 
-use common::{no_adapter, temp_path, verlet};
+use crate::common::{no_adapter, temp_path, verlet};
 
 /// Positions after `steps` steps of `verlet run --builtin blast [extra...]`,
 /// or None when there is no adapter.

@@ -4,8 +4,6 @@
 //! GPU tests skip loudly without an adapter and fail when `CI` is set (see
 //! `common`). `VERLET_UPDATE_GOLDEN=1` rewrites the golden images.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -102,7 +100,7 @@ fn check_golden(name: &str, actual: &RgbaImage) {
 
 /// Renders `scene` after `steps` steps, or None when the test must skip.
 fn render_after(scene: &Scene, steps: u64, options: RenderOptions) -> Option<RgbaImage> {
-    let mut world = common::world(scene)?;
+    let mut world = crate::common::world(scene)?;
     let mut renderer = Renderer::with_options(world.gpu(), scene, WIDTH, HEIGHT, options).unwrap();
     world.step(steps).unwrap();
     Some(renderer.render(&world).unwrap())
@@ -162,7 +160,7 @@ fn silhouette_lands_where_the_camera_projects_it() {
     // centroid from the centre's image, aimed away from the box so it sits
     // off the image's centre
     scene.camera = Some(Camera { position: [6.0, 7.0, 14.0], target: [0.0, 0.5, 0.0], fov_y: 30f32.to_radians() });
-    let Some(world) = common::world(&scene) else { return };
+    let Some(world) = crate::common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, WIDTH, HEIGHT).unwrap();
     renderer.set_body_color(0, [1.0, 0.0, 0.0]).unwrap();
     let img = renderer.render(&world).unwrap();
@@ -184,7 +182,7 @@ fn silhouette_lands_where_the_camera_projects_it() {
 #[test]
 fn default_camera_frames_every_body() {
     let scene = scenes::chain(21);
-    let Some(world) = common::world(&scene) else { return };
+    let Some(world) = crate::common::world(&scene) else { return };
     let renderer = Renderer::new(world.gpu(), &scene, WIDTH, HEIGHT).unwrap();
     let cam = renderer.camera();
     assert_eq!(cam.fov_y, std::f32::consts::FRAC_PI_4);
@@ -207,7 +205,7 @@ fn default_camera_frames_every_body() {
 fn looking_straight_down_turns_up_to_z() {
     let mut scene = scenes::drop();
     scene.camera = Some(Camera { position: [0.0, 10.0, 0.0], target: [0.0, 0.0, 0.0], fov_y: 60f32.to_radians() });
-    let Some(world) = common::world(&scene) else { return };
+    let Some(world) = crate::common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, 64, 48).unwrap();
     assert_eq!(renderer.camera().up, [0.0, 0.0, 1.0]);
     let img = renderer.render(&world).unwrap();
@@ -217,7 +215,7 @@ fn looking_straight_down_turns_up_to_z() {
 #[test]
 fn frames_of_a_moving_scene_differ() {
     let scene = scenes::drop();
-    let Some(mut world) = common::world(&scene) else { return };
+    let Some(mut world) = crate::common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, WIDTH, HEIGHT).unwrap();
     let before = renderer.render(&world).unwrap();
     let again = renderer.render(&world).unwrap();
@@ -233,7 +231,7 @@ fn frames_of_a_moving_scene_differ() {
 fn an_odd_size_renders_unskewed() {
     let (w, h) = (333, 211);
     let scene = scenes::stack(3);
-    let Some(world) = common::world(&scene) else { return };
+    let Some(world) = crate::common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, w, h).unwrap();
     renderer.set_body_color(0, [0.2, 0.4, 1.0]).unwrap();
     renderer.set_body_color(1, [0.2, 0.4, 1.0]).unwrap();
@@ -250,7 +248,7 @@ fn an_odd_size_renders_unskewed() {
 
 #[test]
 fn bad_sizes_are_refused_naming_the_flag() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let scene = scenes::drop();
     let max = gpu.limits.max_texture_dimension_2d;
     for (w, h, flag) in [(0, 240, "--width"), (320, 0, "--height"), (max + 1, 240, "--width"), (320, max + 1, "--height")] {
@@ -264,7 +262,7 @@ fn bad_sizes_are_refused_naming_the_flag() {
 
 #[test]
 fn a_world_of_another_scene_is_refused() {
-    let Some(world) = common::world(&scenes::stack(3)) else { return };
+    let Some(world) = crate::common::world(&scenes::stack(3)) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scenes::stack(4), 32, 32).unwrap();
     assert!(matches!(renderer.render(&world), Err(Error::Input(_))));
 }
@@ -275,7 +273,7 @@ fn spheres_and_fixed_bodies_render() {
     let mut post = scenes::box_body([0.3, 1.0, 0.3], [1.2, 1.0, 0.0]);
     post.fixed = true;
     scene.bodies.push(post);
-    let Some(world) = common::world(&scene) else { return };
+    let Some(world) = crate::common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, 160, 120).unwrap();
     let img = renderer.render(&world).unwrap();
     // the fixed post is grey: its centre pixel has r = g = b within rounding
@@ -357,13 +355,13 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// `cargo test --test render -- --ignored --nocapture timing`: one 640x480
+/// `cargo test --test gpu -- --ignored --nocapture render::timing`: one 640x480
 /// frame of 1000 cubes against one step, wall clock, median of a few.
 #[test]
 #[ignore]
 fn timing_render_vs_step_1000_cubes() {
     let scene = scenes::cubes(1000, 1);
-    let Some(mut world) = common::world(&scene) else { return };
+    let Some(mut world) = crate::common::world(&scene) else { return };
     let mut renderer = Renderer::new(world.gpu(), &scene, 640, 480).unwrap();
     world.step(1).unwrap();
     world.gpu().wait().unwrap();

@@ -1,9 +1,7 @@
 //! `verlet run --frames`: the binary writes the frames INTERFACE.md section 3
 //! promises, and refuses bad image flags cleanly.
 
-mod common;
-
-use common::{no_adapter, temp_path as temp_dir, verlet};
+use crate::common::{no_adapter, temp_path as temp_dir, verlet};
 
 #[test]
 fn frames_are_written_every_k_steps_at_the_asked_size() {

@@ -1,8 +1,6 @@
 //! Known answers for the integrator and the ground contacts (issue 2).
 
-mod common;
-
-use common::{quat, v3, world};
+use crate::common::{quat, v3, world};
 use glam::{DVec3, Quat, Vec3};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::{Ground, Scene, Settings};

@@ -1,9 +1,7 @@
 //! Many bodies colliding (issue 3): piles settle, stacks and pyramids stand,
 //! fast bodies meet walls, friction holds on a ramp, runs repeat bit for bit.
 
-mod common;
-
-use common::{quat, v3, world};
+use crate::common::{quat, v3, world};
 use glam::{Quat, Vec3};
 use verlet::reference::collide::{collide, Placed, ShapeKind};
 use verlet::scenes::{self, box_body};

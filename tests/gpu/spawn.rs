@@ -1,8 +1,6 @@
 //! Adding and removing bodies while a world runs (issue 8, part 2).
 
-mod common;
-
-use common::{v3, world};
+use crate::common::{v3, world};
 use verlet::scenes::{self, box_body};
 use verlet::{Error, Joint};
 

@@ -3,7 +3,7 @@
 //! memory. Too slow for CI on lavapipe, so ignored; run it by hand:
 //!
 //! ```text
-//! cargo test --release --test stress -- --ignored --nocapture
+//! cargo test --release --test gpu -- --ignored --nocapture stress::
 //! ```
 //!
 //! `STRESS_STEPS` and `STRESS_CHUNK` (steps, default 10 000 and 500) shorten
@@ -36,8 +36,6 @@
 //!   the pile and the ground, at 0.2 to 0.5 m/s).
 //! - It caught a leak: a private array in the narrowphase grew the process
 //!   by 1.8 GB in 500 steps (lavapipe; the array is gone).
-
-mod common;
 
 use std::time::Instant;
 
@@ -161,7 +159,7 @@ fn ten_thousand_steps_of_a_5000_body_pile_with_chains() {
     let steps = env_u64("STRESS_STEPS", 10_000);
     let chunk = env_u64("STRESS_CHUNK", 500).max(1);
     let scene = pile_with_chains();
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let rss_start = rss_kb();
     let gpu_start = gpu_memory(&gpu.device);
     let made = Instant::now();
@@ -205,7 +203,7 @@ fn ten_thousand_steps_of_a_5000_body_pile_with_chains() {
         let bodies = world.read_state().unwrap_or_else(|e| panic!("after step {}: {e}", world.step_count()));
         let lowest = bodies.iter().map(|b| b.position[1]).fold(f32::INFINITY, f32::min);
         let highest = bodies.iter().map(|b| b.position[1]).fold(f32::NEG_INFINITY, f32::max);
-        let fastest = bodies.iter().map(|b| common::v3(b.linear_velocity).length()).fold(0.0, f32::max);
+        let fastest = bodies.iter().map(|b| crate::common::v3(b.linear_velocity).length()).fold(0.0, f32::max);
         let rss = rss_kb();
         rss_max = rss_max.max(rss);
         println!(

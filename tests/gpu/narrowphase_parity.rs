@@ -2,9 +2,7 @@
 //! boxes and spheres (thin slabs and needles among them), each pair far from
 //! the others, one step, contacts read back and compared point by point.
 
-mod common;
-
-use common::world;
+use crate::common::world;
 use glam::{Quat, Vec3};
 use verlet::reference::collide::{collide, Placed, ShapeKind};
 use verlet::scenes::{box_body, sphere_body};

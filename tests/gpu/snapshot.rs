@@ -2,8 +2,6 @@
 //! a straight run, through the API and through a file; files that are not
 //! snapshots, and snapshots of other scenes, are refused.
 
-mod common;
-
 use verlet::world::snapshot::Snapshot;
 use verlet::{scenes, Scene, World};
 
@@ -20,7 +18,7 @@ fn temp(name: &str) -> std::path::PathBuf {
 /// Run A: 200 steps straight. Run B: 100 steps, snapshot (through a file
 /// when `via_file`), a fresh world restored from it, 100 more steps.
 fn continue_is_bit_identical(scene: &Scene, via_file: bool) {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let mut a = World::with_gpu(gpu.clone(), scene).unwrap();
     a.step(200).unwrap();
 
@@ -71,7 +69,7 @@ fn restore_from_file_continues_bit_identically_joints() {
 
 #[test]
 fn restore_rewinds_a_world() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let scene = scenes::cubes(50, 3);
     let mut w = World::with_gpu(gpu, &scene).unwrap();
     w.step(30).unwrap();
@@ -88,7 +86,7 @@ fn restore_rewinds_a_world() {
 
 #[test]
 fn restore_into_another_scene_is_refused() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let scene = scenes::cubes(20, 1);
     let mut w = World::with_gpu(gpu.clone(), &scene).unwrap();
     w.step(5).unwrap();
@@ -118,7 +116,7 @@ fn restore_into_another_scene_is_refused() {
 
 #[test]
 fn bad_files_are_refused_with_a_reason() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let scene = scenes::cubes(3, 1);
     let mut w = World::with_gpu(gpu, &scene).unwrap();
     w.step(2).unwrap();
@@ -177,7 +175,7 @@ fn bad_files_are_refused_with_a_reason() {
 /// carry state.
 #[test]
 fn restore_does_not_depend_on_which_buffer_is_current() {
-    let Some(gpu) = common::gpu() else { return };
+    let Some(gpu) = crate::common::gpu() else { return };
     let mut scene = scenes::cubes(100, 2);
     scene.settings.substeps = 1;
     scene.settings.iterations = 3;

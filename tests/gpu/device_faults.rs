@@ -1,8 +1,6 @@
 //! Device faults (issue 7, part 4): a device destroyed in the middle of a
 //! run makes the library return errors, never panic or hang.
 
-mod common;
-
 use std::sync::{mpsc, Arc};
 use std::time::Duration;
 
@@ -28,7 +26,7 @@ fn within<T: Send + 'static>(limit: Duration, what: &str, f: impl FnOnce() -> T 
 
 /// A GPU of its own: destroying the shared one would break the other tests.
 fn own_gpu() -> Option<Arc<Gpu>> {
-    common::gpu()?;
+    crate::common::gpu()?;
     Some(Arc::new(Gpu::new().expect("a second device on the adapter")))
 }
 

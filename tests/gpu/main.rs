@@ -1,0 +1,28 @@
+//! The in-process tests, one binary: the GPU opens once for all of them
+//! (`common::gpu`), and a failure names its module (the part it checks) and
+//! its test. Pure CPU checks (layouts, shaders, the collision reference, the
+//! scene format) live here too.
+
+mod common;
+
+mod capacity;
+mod collide_reference;
+mod determinism;
+mod device_faults;
+mod faults;
+mod input_track;
+mod kernels;
+mod layouts;
+mod narrowphase_parity;
+mod physics_contacts;
+mod physics_core;
+mod physics_joints;
+mod render;
+mod scene_fuzz;
+mod scene_validation;
+mod shaders;
+mod sleeping;
+mod snapshot;
+mod spawn;
+mod stress;
+mod user_input;
