@@ -3,24 +3,9 @@
 //! are apart, no point deeper than the true overlap, every point on or inside
 //! both boxes, at most 8 points sharing one normal.
 
+use crate::common::Rng;
 use glam::{Quat, Vec3};
 use verlet::reference::collide::{box_box, Manifold, EDGE_BIAS};
-
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn quat(&mut self) -> Quat {
-        Quat::from_xyzw(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5, self.f() - 0.5).normalize()
-    }
-}
 
 #[derive(Clone, Copy)]
 struct Obb {

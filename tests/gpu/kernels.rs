@@ -3,6 +3,7 @@
 //! must write, so a regression names its pass.
 
 use crate::common::world;
+use crate::common::Rng;
 use glam::{Quat, Vec3};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
@@ -16,16 +17,6 @@ fn contacts_stages() -> Vec<Stage> {
 
 fn grid_stages() -> Vec<Stage> {
     Stage::ALL.iter().copied().filter(|s| s.is_broadphase()).collect()
-}
-
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
 }
 
 /// The grid kernels sort the bodies as a CPU counting sort does: by hash

@@ -3,24 +3,12 @@
 //! the others, one step, contacts read back and compared point by point.
 
 use crate::common::world;
+use crate::common::Rng;
 use glam::{Quat, Vec3};
 use verlet::reference::collide::{collide, Placed, ShapeKind};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::world::initial_state;
 use verlet::{Body, Scene, Settings, Shape};
-
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn quat(&mut self) -> Quat {
-        Quat::from_xyzw(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5, self.f() - 0.5).normalize()
-    }
-}
 
 fn random_body(rng: &mut Rng, k: usize, at: Vec3) -> Body {
     let mut b = match k % 5 {

@@ -68,3 +68,27 @@ pub fn no_adapter(output: &std::process::Output) -> bool {
     eprintln!("\n!!!!! SKIPPING GPU TEST: the binary found no adapter ({}) !!!!!\n", stderr.trim());
     true
 }
+
+/// A small deterministic generator (xorshift64) for the tests' random
+/// scenes: the same numbers on every machine.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Uniform in [0, 1).
+    pub fn f(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f()
+    }
+
+    /// A random unit quaternion (not uniform over rotations).
+    pub fn quat(&mut self) -> glam::Quat {
+        glam::Quat::from_xyzw(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5, self.f() - 0.5).normalize()
+    }
+}
