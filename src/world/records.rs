@@ -1,0 +1,185 @@
+//! A scene turned into the GPU's records (each body's properties and first
+//! pose, the joint lists, the grid's shape), and a body's GPU state turned
+//! back into what a user reads (`body_output`).
+
+use glam::{DQuat, DVec3};
+
+use super::BodyOutput;
+use crate::gpu::types::*;
+use crate::scene::{Body, Scene, Settings, Shape};
+
+/// The broadphase grid's shape, fixed at start-up from the bodies' sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridLayout {
+    /// Edge of a cell (m): two grid bodies that can touch within the
+    /// speculative gap are never more than one cell apart.
+    pub cell_size: f32,
+    /// Buckets of the hash table (a power of two, about two per body).
+    pub hash_size: u32,
+    /// Farthest gap (m) at which grid pairs get contacts.
+    pub speculative: f32,
+}
+
+/// A body whose bounding radius exceeds this many times the median one is
+/// kept out of the grid (a ramp, a wall, a floor made of boxes) and checked
+/// by every body instead, so it never inflates the cells.
+const LARGE_FACTOR: f32 = 2.0;
+/// At most this many bodies are kept out of the grid; beyond it the cells
+/// grow to hold the rest.
+const MAX_LARGE: usize = 256;
+
+/// Which bodies stay out of the grid, and the grid for the rest.
+pub fn plan_grid(radii: &[f32]) -> (Vec<u32>, GridLayout) {
+    let mut sorted: Vec<f32> = radii.to_vec();
+    sorted.sort_by(f32::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.5);
+    let mut large: Vec<u32> = (0..radii.len() as u32).filter(|&i| radii[i as usize] > LARGE_FACTOR * median).collect();
+    if large.len() > MAX_LARGE {
+        large.sort_by(|&a, &b| radii[b as usize].total_cmp(&radii[a as usize]).then(a.cmp(&b)));
+        large.truncate(MAX_LARGE);
+        large.sort();
+    }
+    let is_large = |i: usize| large.binary_search(&(i as u32)).is_ok();
+    let r = (0..radii.len()).filter(|&i| !is_large(i)).map(|i| radii[i]).fold(0.0f32, f32::max).max(1e-3);
+    let speculative = 0.5 * r;
+    let hash_size = (2 * radii.len()).max(1024).next_power_of_two() as u32;
+    (large, GridLayout { cell_size: 2.0 * r + speculative, hash_size, speculative })
+}
+
+fn dvec(v: [f32; 3]) -> DVec3 {
+    DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
+}
+
+fn dquat(v: [f32; 4]) -> DQuat {
+    DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64)
+}
+
+/// What a user sees of a body: its pose and its velocities at the step's
+/// time, from a Verlet state whose last substep took `dt` s.
+///
+/// The displacement `disp = x_n - x_(n-1)` over `dt` is the mean velocity
+/// over the last substep, the velocity half a substep ago: reported as it
+/// is, a body given zero velocity read `-g dt / 2` (0.027 m/s upward at the
+/// default settings) at step 0. The velocity at the step's time is
+/// `disp / dt + a dt / 2` with `a` the acceleration at that time, exact for
+/// a constant one (`initial_state` sets `disp = v0 dt - g dt^2 / 2`, so step
+/// 0 reads v0 back, and free fall reads v0 + g t at every step). A free body
+/// accelerates at `gravity`; one that something held over the last substep
+/// (a contact pushed it, it is fixed or asleep: `HELD`) or that hangs on a
+/// joint is not known to, and resting on the ground it accelerates at none,
+/// so it reads `disp / dt`, which is 0 at rest. Angular velocity has no
+/// acceleration to correct (no torques): the last substep's turn over dt.
+pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> BodyOutput {
+    let free = s.pos_low & HELD == 0 && !joined;
+    let half_step = if free { DVec3::from_array(gravity.map(|g| g as f64)) * (0.5 * dt) } else { DVec3::ZERO };
+    let disp = DVec3::new(s.disp[0] as f64, s.disp[1] as f64, s.disp[2] as f64);
+    let v = disp / dt + half_step;
+    let mut dq = dquat(s.rot) * dquat(s.prev_rot).conjugate();
+    if dq.w < 0.0 {
+        dq = -dq;
+    }
+    let w = dq.to_scaled_axis() / dt;
+    BodyOutput {
+        position: [s.pos[0], s.pos[1], s.pos[2]],
+        orientation: s.rot,
+        linear_velocity: v.as_vec3().to_array(),
+        angular_velocity: w.as_vec3().to_array(),
+        asleep: s.rest_time >= crate::scene::SLEEP_AFTER,
+    }
+}
+
+/// Each body's ball-joint ends, as CSR lists: body i's are
+/// `refs[starts[i]..starts[i + 1]]`, in the order the joints are listed.
+pub fn joint_lists(scene: &Scene) -> (Vec<u32>, Vec<JointRef>) {
+    let n = scene.bodies.len();
+    let mut per_body: Vec<Vec<JointRef>> = vec![Vec::new(); n];
+    let side = |body: i32| if body < 0 { WORLD } else { body as u32 };
+    for j in &scene.joints {
+        for (me, other) in [(0, 1), (1, 0)] {
+            if j.bodies[me] >= 0 {
+                per_body[j.bodies[me] as usize].push(JointRef {
+                    local_self: j.anchors[me],
+                    partner: side(j.bodies[other]),
+                    local_partner: j.anchors[other],
+                    _pad0: 0,
+                });
+            }
+        }
+    }
+    let mut starts = Vec::with_capacity(n + 1);
+    let mut refs = Vec::new();
+    for list in per_body {
+        starts.push(refs.len() as u32);
+        refs.extend(list);
+    }
+    starts.push(refs.len() as u32);
+    (starts, refs)
+}
+
+/// How far each joint has opened (m): the distance between its two anchors.
+pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
+    let anchor = |body: i32, local: [f32; 3]| -> DVec3 {
+        let l = DVec3::new(local[0] as f64, local[1] as f64, local[2] as f64);
+        if body < 0 {
+            return l;
+        }
+        let s = &states[body as usize];
+        dvec(s.pos) + dquat(s.rot).normalize() * l
+    };
+    scene.joints.iter().map(|j| (anchor(j.bodies[0], j.anchors[0]) - anchor(j.bodies[1], j.anchors[1])).length() as f32).collect()
+}
+
+/// Every body's GPU record, the bodies kept out of the grid (`LARGE_BODY` in
+/// their records) and the grid for the rest.
+pub fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
+    let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &scene.settings)).collect();
+    let radii: Vec<f32> = props.iter().map(|p| p.half_extents[3]).collect();
+    let (large, grid) = plan_grid(&radii);
+    for &i in &large {
+        props[i as usize].grid_class = LARGE_BODY;
+    }
+    (props, large, grid)
+}
+
+/// The GPU record of a body's shape, mass and material.
+pub fn body_props(b: &Body, settings: &Settings) -> BodyProps {
+    let (half, shape) = match b.shape {
+        Shape::Box { half_extents: h } => ([h[0], h[1], h[2]], SHAPE_BOX),
+        Shape::Sphere { radius } => ([radius, radius, radius], SHAPE_SPHERE),
+    };
+    let ii = b.inverse_inertia();
+    BodyProps {
+        half_extents: [half[0], half[1], half[2], b.bounding_radius()],
+        inv_inertia: [ii[0], ii[1], ii[2], b.inverse_mass()],
+        restitution: b.restitution.unwrap_or(settings.restitution),
+        friction: b.friction.unwrap_or(settings.friction),
+        shape,
+        flags: if b.fixed { FLAG_FIXED } else { 0 },
+        grid_class: GRID_BODY,
+        ..Default::default()
+    }
+}
+
+/// The starting pose, with the displacement from the previous pose set so
+/// that the first Verlet step reproduces the initial velocities exactly:
+/// disp = x0 - x_prev = v0 h - g h^2/2 makes x1 = x0 + v0 h + g h^2/2, and
+/// Verlet then stays on the parabola. A fixed body is `HELD` (see
+/// [`body_output`]); no rounding remainder yet (x0 is exact).
+pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
+    let x0 = DVec3::from_array(b.position.map(|v| v as f64));
+    let o = b.orientation;
+    let q0 = DQuat::from_xyzw(o[0] as f64, o[1] as f64, o[2] as f64, o[3] as f64).normalize();
+    let (disp, prev_q) = if b.fixed {
+        (DVec3::ZERO, q0)
+    } else {
+        let h = (settings.dt / settings.substeps as f32) as f64;
+        let v0 = DVec3::from_array(b.linear_velocity.map(|v| v as f64));
+        let w0 = DVec3::from_array(b.angular_velocity.map(|v| v as f64));
+        let g = DVec3::from_array(settings.gravity.map(|v| v as f64));
+        (v0 * h - 0.5 * g * h * h, (DQuat::from_scaled_axis(-w0 * h) * q0).normalize())
+    };
+    let v3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
+    let q4 = |q: DQuat| [q.x as f32, q.y as f32, q.z as f32, q.w as f32];
+    let x = v3(x0);
+    BodyState { pos: x, rest_time: 0.0, disp: v3(disp), pos_low: if b.fixed { HELD } else { 0 }, rot: q4(q0), prev_rot: q4(prev_q) }
+}
