@@ -13,6 +13,7 @@ use verlet::render::{self, Renderer};
 use verlet::track::Track;
 use verlet::{gpu::Gpu, output, scenes, Error, Scene, World};
 
+mod harness;
 mod plot;
 
 #[derive(Parser)]
@@ -222,7 +223,7 @@ fn bench(a: BenchArgs) -> Result<(), verlet::Error> {
             .collect();
         verlet::output::check_distinct(&[], &outputs)?;
     }
-    let report = verlet::bench::run(&verlet::bench::Options {
+    let report = harness::run(&harness::Options {
         cases: a.cases,
         steps: a.steps,
         body_steps: a.body_steps,

@@ -4,8 +4,8 @@
 //! into its parts (GPU timestamps), stacked. SVG only: its text is left to
 //! the viewer's fonts, so drawing it needs no font files.
 
+use crate::harness::Report;
 use plotters::prelude::*;
-use verlet::bench::Report;
 
 /// One case as the chart shows it.
 pub struct Row {

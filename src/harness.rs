@@ -1,0 +1,1117 @@
+//! `verlet bench`: the throughput benchmark's harness (issue 6), in the
+//! binary so that the library holds no peer engine; the workloads (the
+//! named cases, the copy kernel) are the library's `verlet::bench`.
+//!
+//! Named cases (built-in scenes at fixed sizes, shared with `benches/step.rs`)
+//! are each run as:
+//!
+//! 1. **start-up**: the first `World::with_gpu` of the case (pipelines
+//!    compiled — slow on lavapipe, which JIT-compiles every kernel with LLVM —
+//!    and buffers uploaded) and its first step, timed apart from everything
+//!    else and then thrown away;
+//! 2. **repetitions**: `reps` fresh worlds of the same scene, each taking one
+//!    untimed step (lavapipe loads a world's pipelines at first dispatch) and
+//!    then timed over the same `steps` steps (wall clock from the first
+//!    submission to the GPU going idle); the median is reported;
+//! 3. **per stage**: `World::profile` over a few more steps of the last
+//!    repetition's world (GPU timestamp queries where the adapter has them,
+//!    else the wall clock around each pass), a blocking readback of the whole
+//!    state, and for `cubes-1k` an off-screen render at 640 x 480;
+//! 4. **limits**: a memory-bound copy of the state buffer (an inline WGSL
+//!    kernel reading and writing 64 bytes per body, timed like the passes)
+//!    as the physical floor of the integration pass;
+//! 5. **peer** (feature `rapier`): the identical scene stepped the same
+//!    number of steps by rapier3d on the CPU, timed the same way.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use verlet::bench::{case, Case, CopyKernel, CASES, QUICK_CASES, SEED};
+use verlet::gpu::{types::*, Gpu};
+use verlet::render::Renderer;
+use verlet::scene::Scene;
+use verlet::step::Part;
+use verlet::world::{self, StageTimes, World};
+use verlet::{scenes, Error};
+
+/// Steps per repetition unless `--steps` says: the issue's "10 000 cubes
+/// piling up (300 steps)", 5 s of simulated time at 60 Hz.
+pub const DEFAULT_STEPS: u64 = 300;
+pub const QUICK_STEPS: u64 = 60;
+/// Body-steps per repetition unless `--body-steps` says: a case takes
+/// `min(steps, max(MIN_STEPS, body_steps / bodies))` steps, so the large
+/// cases finish (300 steps of 10 000 cubes; 30 of 100 000).
+pub const DEFAULT_BODY_STEPS: u64 = 3_000_000;
+pub const QUICK_BODY_STEPS: u64 = 600_000;
+/// The fewest steps a repetition takes, whatever the budget.
+pub const MIN_STEPS: u64 = 20;
+pub const DEFAULT_REPS: usize = 3;
+pub const QUICK_REPS: usize = 2;
+/// Steps timed stage by stage after the repetitions.
+pub const PROFILE_STEPS: u64 = 10;
+
+/// What `verlet bench` was asked to do.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// Case names or `SCENE:COUNT`; empty: all of `CASES` (`QUICK_CASES` with `quick`).
+    pub cases: Vec<String>,
+    pub steps: Option<u64>,
+    /// Body-steps per repetition (caps the steps of large cases).
+    pub body_steps: Option<u64>,
+    pub reps: Option<usize>,
+    pub quick: bool,
+    pub profile_steps: Option<u64>,
+    pub json: Option<PathBuf>,
+    pub csv: Option<PathBuf>,
+    /// Skip the rapier3d peer even when it is built in (without the
+    /// `rapier` feature there is none, and the peer's options go unread).
+    #[cfg_attr(not(feature = "rapier"), allow(dead_code))]
+    pub no_peer: bool,
+    /// The peer only for cases of at most this many bodies.
+    #[cfg_attr(not(feature = "rapier"), allow(dead_code))]
+    pub peer_max_bodies: Option<usize>,
+    /// Let bodies sleep, ours and rapier's (off by default in the bench, so
+    /// that every body is simulated every step in both).
+    pub rapier_sleeping: bool,
+    /// rapier's `num_solver_iterations`; `None`: rapier's default (4).
+    #[cfg_attr(not(feature = "rapier"), allow(dead_code))]
+    pub rapier_iterations: Option<usize>,
+    /// The command line, recorded in the outputs.
+    pub command: String,
+}
+
+/// Per-stage cost of a step (ms per step, summed over substeps and iterations).
+#[derive(Clone, Debug, Serialize)]
+pub struct Stages {
+    /// "GPU timestamps" or "wall clock per pass".
+    pub source: String,
+    pub steps: u64,
+    /// The seven grid passes together.
+    pub broadphase: f64,
+    /// The pair list (`pairs_*`), the narrowphase and its dispatch.
+    pub narrowphase: f64,
+    pub integrate: f64,
+    /// Both halves of every sweep (`solve_contacts`, `solve`).
+    pub solve: f64,
+    /// Both halves (`restitution_contacts`, `restitution`).
+    pub restitution: f64,
+    /// Sum of the above.
+    pub total: f64,
+    /// Every pass by its entry point.
+    pub passes: Vec<(String, f64)>,
+}
+
+impl Stages {
+    fn from_times(t: &StageTimes, steps: u64) -> Stages {
+        let part = |p: Part| t.ms_per_step.iter().filter(|(s, _)| s.part() == p).map(|x| x.1).sum::<f64>();
+        let (broadphase, narrowphase, integrate, solve, restitution) =
+            (part(Part::Broadphase), part(Part::Narrowphase), part(Part::Integrate), part(Part::Solve), part(Part::Restitution));
+        Stages {
+            source: if t.gpu_timestamps { "GPU timestamps" } else { "wall clock per pass" }.into(),
+            steps,
+            broadphase,
+            narrowphase,
+            integrate,
+            solve,
+            restitution,
+            total: broadphase + narrowphase + integrate + solve + restitution,
+            passes: t.ms_per_step.iter().map(|(s, ms)| (s.name().to_string(), *ms)).collect(),
+        }
+    }
+}
+
+/// The CPU peer's figures for one case.
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerResult {
+    pub engine: String,
+    pub threads: String,
+    pub sleeping: bool,
+    pub num_solver_iterations: usize,
+    pub setup_s: f64,
+    pub ms_per_step: Vec<f64>,
+    pub median_ms_per_step: f64,
+    pub body_steps_per_s: f64,
+    /// Peer ms/step over ours: above 1, we are faster.
+    pub speedup: f64,
+    /// Mean height of the movable bodies after the last repetition (m).
+    pub mean_height: f64,
+}
+
+/// One case's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseResult {
+    pub case: String,
+    pub scene: String,
+    pub bodies: usize,
+    pub joints: usize,
+    /// The scene's relaxation iterations per substep and substeps per step.
+    pub iterations: u32,
+    pub substeps: u32,
+    /// Why the case did not run (it does not fit the adapter), if it did not.
+    pub skipped: Option<String>,
+    /// A note on the case (run at a smaller size than named, and why).
+    pub note: Option<String>,
+    pub steps: u64,
+    pub reps: usize,
+    /// The case's first `World::with_gpu` and first step, waited for (s):
+    /// upload, and on lavapipe the JIT compilation of every pipeline, which
+    /// happens at first use (fast when Mesa's on-disk shader cache has them).
+    pub startup_s: f64,
+    /// Of which the first step (ms).
+    pub first_step_ms: f64,
+    /// Median `World::with_gpu` and untimed first step of the repetitions (s).
+    pub setup_s: f64,
+    pub ms_per_step: Vec<f64>,
+    pub median_ms_per_step: f64,
+    pub body_steps_per_s: f64,
+    /// `world::bytes_per_body() * bodies`.
+    pub gpu_bytes_estimate: u64,
+    /// Every buffer `World::with_gpu` allocates for this scene, sized as it
+    /// sizes them (hash table at its rounded size, params slots, joints).
+    pub gpu_bytes: u64,
+    pub gpu_bytes_per_body: f64,
+    pub stages: Option<Stages>,
+    /// `World::read_state` of every body (ms, median of 3).
+    pub readback_ms: f64,
+    /// `Renderer::new` for the 1000-cube scene at 640 x 480 (s), on the cubes-1k row.
+    pub render_setup_s: Option<f64>,
+    /// `Renderer::render` at 640 x 480 including its image readback (ms, median of 3).
+    pub render_ms: Option<f64>,
+    /// One integrate pass (ms): the profile's integrate time over substeps.
+    pub integrate_ms_per_pass: Option<f64>,
+    /// One pass of the copy kernel over the same number of bodies (ms).
+    pub copy_ms_per_pass: Option<f64>,
+    /// Most contact manifolds (pairs with contact points) in any step, and
+    /// whether the pair list or the manifold pool overflowed.
+    pub max_contacts: u32,
+    pub contacts_overflowed: bool,
+    /// Mean height of the movable bodies after the last repetition (m).
+    pub mean_height: f64,
+    /// The machine's 1-minute load average when the case started and ended
+    /// (Linux): above the core count, other work shared the CPU (and so
+    /// lavapipe) and the times are inflated.
+    pub load_avg: Option<[f64; 2]>,
+    pub peer: Option<PeerResult>,
+}
+
+/// Exponent of time per step against bodies.
+#[derive(Clone, Debug, Serialize)]
+pub struct Scaling {
+    /// The cubes cases fitted: (bodies, ms/step).
+    pub points: Vec<(usize, f64)>,
+    /// Least-squares slope of ln(ms/step) on ln(bodies).
+    pub exponent: f64,
+    /// Largest over smallest cost per body-step among the points.
+    pub spread: f64,
+}
+
+/// A target of issue 6, measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Target {
+    pub target: String,
+    /// `None`: not measured in this run.
+    pub met: Option<bool>,
+    pub measured: String,
+}
+
+/// Everything `verlet bench` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub command: String,
+    pub cpu: String,
+    pub cores: usize,
+    pub adapter: String,
+    pub gpu_timestamps: bool,
+    pub max_bodies: u64,
+    pub max_storage_buffer_binding_size: u64,
+    pub bytes_per_body: u64,
+    /// How our iteration counts compare with the peer's, in words.
+    pub iterations: String,
+    pub peer: String,
+    pub gpu_open_s: f64,
+    /// `Renderer::new` for the 1000-cube scene at 640 x 480 (s).
+    pub render_setup_s: Option<f64>,
+    /// `Renderer::render` of it, landed (60 steps), image read back included (ms, median of 3).
+    pub render_ms: Option<f64>,
+    /// Whether start-up times had Mesa's shader cache to draw on.
+    pub shader_cache: String,
+    pub cases: Vec<CaseResult>,
+    pub scaling: Option<Scaling>,
+    pub targets: Vec<Target>,
+}
+
+fn median(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let m = s.len() / 2;
+    if s.len() % 2 == 1 {
+        s[m]
+    } else {
+        0.5 * (s[m - 1] + s[m])
+    }
+}
+
+/// The processor's model name (Linux), else "unknown".
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split_once(':')).map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// The bytes `World::with_gpu` allocates for `scene` (mirrors its buffer
+/// sizes: two state buffers, props, vel0, the grid at its rounded hash size,
+/// the pair list and manifold pool at their per-body sizes (smaller where a
+/// binding caps them), status, the indirect dispatch, params slots and the
+/// joint lists).
+pub fn gpu_bytes(scene: &Scene) -> u64 {
+    let n = scene.bodies.len().max(1) as u64;
+    let radii: Vec<f32> = scene.bodies.iter().map(|b| b.bounding_radius()).collect();
+    let (large, grid) = world::plan_grid(&radii);
+    let size = |s: u64| s.max(16);
+    let hash = grid.hash_size as u64;
+    let state = std::mem::size_of::<BodyState>() as u64;
+    let (pairs, manifolds) = (n * world::PAIRS_PER_BODY, n * world::MANIFOLDS_PER_BODY);
+    let joints = (scene.bodies.len() as u64 + 1) * 4 + 2 * scene.joints.len() as u64 * std::mem::size_of::<JointRef>() as u64;
+    2 * size(n * state)
+        + size(n * std::mem::size_of::<BodyProps>() as u64)
+        + size(n * std::mem::size_of::<Velocity>() as u64)
+        + size(4 * hash)
+        + size(4 * (hash + 1))
+        + size(8 * hash.max(n).div_ceil(SCAN_BLOCK as u64))
+        + size(4 * n)
+        + size(4 * large.len() as u64)
+        + size(pairs * std::mem::size_of::<Pair>() as u64)
+        + size(manifolds * std::mem::size_of::<ContactManifold>() as u64)
+        + size(manifolds * std::mem::size_of::<ManifoldSnaps>() as u64)
+        + size((n + 1) * std::mem::size_of::<PairMeta>() as u64)
+        + size(2 * pairs * 4)
+        + 64
+        + 32
+        + PARAMS_STRIDE * 64
+        + joints
+}
+
+/// The 1-minute load average (Linux).
+pub fn load_avg() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
+}
+
+fn mean_height(bodies: impl Iterator<Item = f32>) -> f64 {
+    let (sum, count) = bodies.fold((0.0f64, 0usize), |(s, c), y| (s + y as f64, c + 1));
+    if count == 0 {
+        0.0
+    } else {
+        sum / count as f64
+    }
+}
+
+// ---------------------------------------------------------------------------
+
+/// The identical scene in rapier3d: same bodies (shapes, sizes, masses,
+/// poses, velocities), friction combined as our geometric mean and
+/// restitution as our max, the ground as a fixed half-space, the same dt,
+/// gravity and damping (our β per step as rapier's coefficient
+/// `-ln(1 - β) / dt`), ball joints as spherical impulse joints whose bodies
+/// do not collide (as ours do not), world-pinned ends on a fixed body at the
+/// origin. Bodies never sleep unless asked; CCD is off as rapier's default.
+#[cfg(feature = "rapier")]
+pub mod peer {
+    use rapier3d::na::Unit;
+    use rapier3d::prelude::*;
+
+    use verlet::scene::{Scene, Shape};
+
+    /// The peer's name as reported.
+    pub const ENGINE: &str = "rapier3d 0.36";
+
+    /// Whether rapier3d was built with its rayon-parallel pipeline.
+    pub const PARALLEL: bool = cfg!(feature = "rapier-parallel");
+
+    pub struct RapierWorld {
+        pub world: PhysicsWorld,
+    }
+
+    impl RapierWorld {
+        pub fn new(scene: &Scene, sleeping: bool, iterations: Option<usize>) -> RapierWorld {
+            let s = &scene.settings;
+            let mut w = PhysicsWorld { gravity: Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]), ..Default::default() };
+            w.integration_parameters.dt = s.dt;
+            if let Some(k) = iterations {
+                w.integration_parameters.num_solver_iterations = k.max(1);
+            }
+            let damping = |beta: f32| -((1.0 - beta as f64).ln() / s.dt as f64) as f32;
+            let material = |c: ColliderBuilder, friction: f32, restitution: f32| {
+                c.friction(friction)
+                    .friction_combine_rule(CoefficientCombineRule::GeometricMean)
+                    .restitution(restitution)
+                    .restitution_combine_rule(CoefficientCombineRule::Max)
+            };
+            if let Some(g) = &scene.ground {
+                let ground =
+                    ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Y)).translation(Vector::new(0.0, g.height, 0.0));
+                w.insert_collider(material(ground, s.friction, s.restitution), None);
+            }
+            let mut handles = Vec::with_capacity(scene.bodies.len());
+            for b in &scene.bodies {
+                let o = b.orientation;
+                let pose = Pose::from_parts(
+                    Vector::new(b.position[0], b.position[1], b.position[2]),
+                    Rotation::from_xyzw(o[0], o[1], o[2], o[3]).normalize(),
+                );
+                let body = if b.fixed { RigidBodyBuilder::fixed() } else { RigidBodyBuilder::dynamic() }
+                    .pose(pose)
+                    .linvel(Vector::new(b.linear_velocity[0], b.linear_velocity[1], b.linear_velocity[2]))
+                    .angvel(Vector::new(b.angular_velocity[0], b.angular_velocity[1], b.angular_velocity[2]))
+                    .linear_damping(damping(s.linear_damping))
+                    .angular_damping(damping(s.angular_damping))
+                    .can_sleep(sleeping);
+                let shape = match b.shape {
+                    Shape::Box { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
+                    Shape::Sphere { radius } => ColliderBuilder::ball(radius),
+                };
+                let collider =
+                    material(shape.mass(b.mass), b.friction.unwrap_or(s.friction), b.restitution.unwrap_or(s.restitution));
+                handles.push(w.insert(body, collider).0);
+            }
+            let mut anchor_body = None;
+            for j in &scene.joints {
+                let mut side = |k: usize| -> RigidBodyHandle {
+                    if j.bodies[k] >= 0 {
+                        handles[j.bodies[k] as usize]
+                    } else {
+                        *anchor_body.get_or_insert_with(|| w.insert_body(RigidBodyBuilder::fixed()))
+                    }
+                };
+                let (h1, h2) = (side(0), side(1));
+                let a = |k: usize| Vector::new(j.anchors[k][0], j.anchors[k][1], j.anchors[k][2]);
+                let joint = SphericalJointBuilder::new().local_anchor1(a(0)).local_anchor2(a(1)).contacts_enabled(false);
+                w.impulse_joints.insert(h1, h2, joint, true);
+            }
+            RapierWorld { world: w }
+        }
+
+        pub fn step(&mut self, steps: u64) {
+            for _ in 0..steps {
+                self.world.step();
+            }
+        }
+
+        pub fn num_solver_iterations(&self) -> usize {
+            self.world.integration_parameters.num_solver_iterations
+        }
+
+        /// Mean height of the dynamic bodies (m).
+        pub fn mean_height(&self) -> f64 {
+            super::mean_height(self.world.bodies.iter().filter(|(_, b)| b.is_dynamic()).map(|(_, b)| b.translation().y))
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Running
+// ---------------------------------------------------------------------------
+
+macro_rules! progress {
+    ($($t:tt)*) => {{ eprintln!($($t)*); }};
+}
+
+/// Runs the benchmark and prints the report; writes `--json` and `--csv`.
+pub fn run(opts: &Options) -> Result<Report, Error> {
+    let steps = opts.steps.unwrap_or(if opts.quick { QUICK_STEPS } else { DEFAULT_STEPS });
+    let reps = opts.reps.unwrap_or(if opts.quick { QUICK_REPS } else { DEFAULT_REPS });
+    let profile_steps = opts.profile_steps.unwrap_or(if opts.quick { 3 } else { PROFILE_STEPS });
+    let body_steps = opts.body_steps.unwrap_or(if opts.quick { QUICK_BODY_STEPS } else { DEFAULT_BODY_STEPS });
+    if steps == 0 {
+        return Err(Error::Input("--steps: must be at least 1".into()));
+    }
+    if reps == 0 {
+        return Err(Error::Input("--reps: must be at least 1".into()));
+    }
+    let specs: Vec<String> = if opts.cases.is_empty() {
+        if opts.quick {
+            QUICK_CASES.iter().map(|s| s.to_string()).collect()
+        } else {
+            CASES.iter().map(|c| c.0.to_string()).collect()
+        }
+    } else {
+        opts.cases.iter().flat_map(|s| s.split(',')).map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect()
+    };
+    let blanks = opts.cases.iter().flat_map(|s| s.split(',')).filter(|s| s.trim().is_empty()).count();
+    if !opts.cases.is_empty() && specs.is_empty() {
+        return Err(Error::Input(format!("--cases: names no case (got {:?}); give names, comma-separated", opts.cases.join(","))));
+    }
+    if blanks > 0 && !opts.cases.is_empty() {
+        progress!("warning: --cases: {blanks} empty name(s) between commas skipped");
+    }
+    let cases: Vec<Case> = specs.iter().map(|s| Case::parse(s)).collect::<Result<_, _>>()?;
+    // fail on unwritable or clashing outputs before the long run, not after it
+    let outputs: Vec<(&str, &std::path::Path)> = [("--json", &opts.json), ("--csv", &opts.csv)]
+        .into_iter()
+        .filter_map(|(flag, p)| p.as_deref().map(|p| (flag, p)))
+        .collect();
+    for (flag, path) in &outputs {
+        verlet::output::check_output(flag, path)?;
+    }
+    verlet::output::check_distinct(&[], &outputs)?;
+
+    let started = Instant::now();
+    let gpu = Arc::new(Gpu::new()?);
+    let gpu_open_s = started.elapsed().as_secs_f64();
+    let max = world::max_bodies(&gpu);
+    let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    progress!("bench: {} (up to {steps} steps, at most {body_steps} body-steps, x {reps} reps per case)", gpu.describe());
+    let mesa_cache = std::env::var("MESA_SHADER_CACHE_DISABLE").is_ok_and(|v| v == "true" || v == "1");
+
+    let settings = verlet::Settings::default();
+    let (peer_name, iterations) = peer_description(opts, &settings);
+    let mut results = Vec::new();
+    for case in &cases {
+        let before = load_avg();
+        let mut r = run_case(&gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
+        r.load_avg = before.zip(load_avg()).map(|(a, b)| [a, b]);
+        results.push(r);
+    }
+    // Rendering comes last: on lavapipe (Mesa 22.3) compute-pass timestamps
+    // taken after a render pass on the same device come out near zero, so a
+    // render before a profile would corrupt the per-stage table.
+    let render = if profile_steps > 0 { Some(render_cubes(&gpu)?) } else { None };
+    if let (Some((setup, ms)), Some(r)) = (render, results.iter_mut().find(|r| r.case == "cubes-1k")) {
+        r.render_setup_s = Some(setup);
+        r.render_ms = Some(ms);
+    }
+    let report = Report {
+        command: opts.command.clone(),
+        cpu: cpu_model(),
+        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        adapter: gpu.describe(),
+        gpu_timestamps: timestamps,
+        max_bodies: max,
+        max_storage_buffer_binding_size: gpu.limits.max_storage_buffer_binding_size,
+        bytes_per_body: world::bytes_per_body(),
+        iterations,
+        peer: peer_name,
+        gpu_open_s,
+        render_setup_s: render.map(|r| r.0),
+        render_ms: render.map(|r| r.1),
+        shader_cache: if mesa_cache { "disabled (MESA_SHADER_CACHE_DISABLE)" } else { "Mesa's default (on-disk cache on)" }.into(),
+        scaling: scaling(&results),
+        targets: Vec::new(),
+        cases: results,
+    };
+    let report = Report { targets: targets(&report), ..report };
+    print!("{}", table(&report));
+    if let Some(path) = &opts.json {
+        let text = serde_json::to_string_pretty(&report).expect("the report serialises");
+        verlet::output::write_file(path, &text)?;
+    }
+    if let Some(path) = &opts.csv {
+        verlet::output::write_file(path, &csv(&report))?;
+    }
+    Ok(report)
+}
+
+/// Renders the 1000-cube scene after 60 steps at 640 x 480: (set-up s, ms per frame).
+fn render_cubes(gpu: &Arc<Gpu>) -> Result<(f64, f64), Error> {
+    let scene = case("cubes-1k").scene();
+    let mut world = World::with_gpu(gpu.clone(), &scene)?;
+    world.step(60)?;
+    gpu.wait()?;
+    let t = Instant::now();
+    let mut renderer = Renderer::new(gpu, &scene, 640, 480)?;
+    let setup = t.elapsed().as_secs_f64();
+    renderer.render(&world)?; // the first frame compiles the raster pipelines
+    let mut frames = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        renderer.render(&world)?;
+        frames.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    progress!("render: cubes-1k at 640x480: {:.1} ms/frame (set-up {setup:.2} s)", median(&frames));
+    Ok((setup, median(&frames)))
+}
+
+fn peer_description(opts: &Options, settings: &verlet::Settings) -> (String, String) {
+    let ours = format!(
+        "ours: {} Jacobi iterations x {} substeps = {} relaxation sweeps per step by default (each case's own in its row), \
+         contacts found once per step",
+        settings.iterations,
+        settings.substeps,
+        settings.iterations * settings.substeps
+    );
+    #[cfg(feature = "rapier")]
+    {
+        let k = opts.rapier_iterations.unwrap_or_else(|| rapier3d::prelude::IntegrationParameters::default().num_solver_iterations);
+        let name = format!(
+            "{} ({}), sleeping {}, CCD off, num_solver_iterations = {k}{}",
+            peer::ENGINE,
+            if peer::PARALLEL { "rayon-parallel" } else { "single-threaded" },
+            if opts.rapier_sleeping { "on" } else { "off" },
+            if opts.rapier_iterations.is_some() { "" } else { " (its default)" },
+        );
+        let its = format!(
+            "{ours}; rapier: num_solver_iterations = {k} (TGS-soft substeps, each 1 PGS velocity iteration + 1 stabilisation \
+             iteration, Gauss-Seidel), contacts found once per step"
+        );
+        (if opts.no_peer { "none (--no-peer)".into() } else { name }, its)
+    }
+    #[cfg(not(feature = "rapier"))]
+    {
+        let _ = opts;
+        ("none (built without --features rapier)".into(), ours)
+    }
+}
+
+/// A case's result before anything is measured.
+fn blank(case: &Case, scene: &Scene, steps: u64, reps: usize) -> CaseResult {
+    let n = scene.bodies.len();
+    CaseResult {
+        case: case.name.clone(),
+        scene: case.scene.clone(),
+        bodies: n,
+        joints: scene.joints.len(),
+        iterations: scene.settings.iterations,
+        substeps: scene.settings.substeps,
+        skipped: None,
+        note: None,
+        steps,
+        reps,
+        startup_s: f64::NAN,
+        first_step_ms: f64::NAN,
+        setup_s: f64::NAN,
+        ms_per_step: Vec::new(),
+        median_ms_per_step: f64::NAN,
+        body_steps_per_s: f64::NAN,
+        gpu_bytes_estimate: world::bytes_per_body() * n as u64,
+        gpu_bytes: gpu_bytes(scene),
+        gpu_bytes_per_body: gpu_bytes(scene) as f64 / n.max(1) as f64,
+        stages: None,
+        readback_ms: f64::NAN,
+        render_setup_s: None,
+        render_ms: None,
+        integrate_ms_per_pass: None,
+        copy_ms_per_pass: None,
+        max_contacts: 0,
+        contacts_overflowed: false,
+        mean_height: f64::NAN,
+        load_avg: None,
+        peer: None,
+    }
+}
+
+fn run_case(
+    gpu: &Arc<Gpu>,
+    case: &Case,
+    (steps, body_steps): (u64, u64),
+    reps: usize,
+    profile_steps: u64,
+    max: u64,
+    opts: &Options,
+) -> Result<CaseResult, Error> {
+    let mut case = case.clone();
+    let mut note = None;
+    // counted before it is built: a case beyond the adapter is not made
+    let bodies = scenes::body_count(&case.scene, case.count).unwrap_or(0);
+    if bodies > max {
+        let why = scenes::check(&case.scene, case.count, max)
+            .err()
+            .map_or_else(|| format!("{bodies} bodies exceed max_bodies = {max}"), |e| e.to_string());
+        if case.scene != "cubes" || max == 0 {
+            progress!("warning: {}: does not fit, skipped: {why}", case.name);
+            let empty = scenes::by_name(&case.scene, Some(0), SEED).unwrap_or_default();
+            // estimated from the count: the scene is not built
+            let estimate = world::bytes_per_body().saturating_mul(bodies);
+            return Ok(CaseResult {
+                skipped: Some(why),
+                bodies: bodies as usize,
+                gpu_bytes_estimate: estimate,
+                gpu_bytes: estimate,
+                gpu_bytes_per_body: world::bytes_per_body() as f64,
+                ..blank(&case, &empty, steps, reps)
+            });
+        }
+        let n = max as usize;
+        progress!("warning: {}: does not fit ({why}); running {n} cubes, the adapter's maximum, instead", case.name);
+        note = Some(format!("{bodies} cubes do not fit ({why}); run at the adapter's maximum, {n}"));
+        case.count = Some(n);
+        case.name = format!("cubes-max ({n})");
+    }
+    let mut scene = case.scene();
+    // both engines sleep, or neither (the peer's default: off)
+    scene.settings.sleeping = opts.rapier_sleeping;
+    let n = scene.bodies.len();
+    let steps = steps.min((body_steps / n.max(1) as u64).max(MIN_STEPS));
+    let profile_steps = profile_steps.min((body_steps / 10 / n.max(1) as u64).max(3));
+    let mut out = CaseResult { note, ..blank(&case, &scene, steps, reps) };
+
+    // 1. start-up, apart
+    let t = Instant::now();
+    let mut world = World::with_gpu(gpu.clone(), &scene)?;
+    gpu.wait()?;
+    let upload = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    world.step(1)?;
+    gpu.wait()?;
+    out.first_step_ms = t.elapsed().as_secs_f64() * 1e3;
+    out.startup_s = upload + out.first_step_ms * 1e-3;
+    drop(world);
+    progress!(
+        "{}: {n} bodies, start-up {:.2} s (first step {:.1} ms); {steps} steps per rep",
+        case.name,
+        out.startup_s,
+        out.first_step_ms
+    );
+
+    // 2. repetitions from the same initial state
+    let mut setups = Vec::new();
+    let mut last = None;
+    for r in 0..reps {
+        let t = Instant::now();
+        let mut world = World::with_gpu(gpu.clone(), &scene)?;
+        // lavapipe loads (or, with its shader cache off, compiles) a world's
+        // pipelines at their first dispatch: keep that out of the timing
+        world.step(1)?;
+        gpu.wait()?;
+        setups.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        world.step(steps)?;
+        gpu.wait()?;
+        let ms = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
+        out.ms_per_step.push(ms);
+        progress!("{}: rep {}/{reps}: {ms:.3} ms/step", case.name, r + 1);
+        last = Some(world);
+    }
+    let mut world = last.expect("reps >= 1");
+    out.setup_s = median(&setups);
+    out.median_ms_per_step = median(&out.ms_per_step);
+    out.body_steps_per_s = n as f64 / (out.median_ms_per_step * 1e-3);
+
+    // 3. the state, a readback, the stages, a render
+    let mut readbacks = Vec::new();
+    let mut bodies = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        bodies = world.read_state()?;
+        readbacks.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    out.readback_ms = median(&readbacks);
+    out.mean_height = mean_height(bodies.iter().zip(&scene.bodies).filter(|(_, b)| !b.fixed).map(|(o, _)| o.position[1]));
+    let report = world.contact_report()?;
+    out.max_contacts = report.manifolds_max;
+    out.contacts_overflowed = report.overflowed();
+    if profile_steps > 0 {
+        let times = world.profile(profile_steps)?;
+        let stages = Stages::from_times(&times, profile_steps);
+        out.integrate_ms_per_pass = Some(stages.integrate / scene.settings.substeps.max(1) as f64);
+        out.stages = Some(stages);
+        let copy = CopyKernel::new(gpu, n)?;
+        copy.time(gpu, 3)?; // compile and warm
+        out.copy_ms_per_pass = Some(median(&copy.time(gpu, 20)?));
+    }
+    drop(world);
+    progress!(
+        "{}: median {:.3} ms/step, {:.3e} body-steps/s, {:.0} B/body",
+        case.name,
+        out.median_ms_per_step,
+        out.body_steps_per_s,
+        out.gpu_bytes_per_body
+    );
+
+    // 5. the peer
+    out.peer = run_peer(&case, &scene, steps, reps, out.median_ms_per_step, opts);
+    Ok(out)
+}
+
+#[cfg(feature = "rapier")]
+fn run_peer(case: &Case, scene: &Scene, steps: u64, reps: usize, ours_ms: f64, opts: &Options) -> Option<PeerResult> {
+    if opts.no_peer || opts.peer_max_bodies.is_some_and(|m| scene.bodies.len() > m) {
+        return None;
+    }
+    let mut times = Vec::new();
+    let mut setups = Vec::new();
+    let mut last = None;
+    for r in 0..reps {
+        let t = Instant::now();
+        let mut w = peer::RapierWorld::new(scene, opts.rapier_sleeping, opts.rapier_iterations);
+        w.step(1); // as ours: the first step untimed, the same steps timed
+        setups.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        w.step(steps);
+        let ms = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
+        progress!("{}: rapier rep {}/{reps}: {ms:.3} ms/step", case.name, r + 1);
+        times.push(ms);
+        last = Some(w);
+    }
+    let w = last?;
+    let m = median(&times);
+    Some(PeerResult {
+        engine: peer::ENGINE.into(),
+        threads: if peer::PARALLEL { "rayon".into() } else { "1".into() },
+        sleeping: opts.rapier_sleeping,
+        num_solver_iterations: w.num_solver_iterations(),
+        setup_s: median(&setups),
+        ms_per_step: times,
+        median_ms_per_step: m,
+        body_steps_per_s: scene.bodies.len() as f64 / (m * 1e-3),
+        speedup: m / ours_ms,
+        mean_height: w.mean_height(),
+    })
+}
+
+#[cfg(not(feature = "rapier"))]
+fn run_peer(_: &Case, _: &Scene, _: u64, _: usize, _: f64, _: &Options) -> Option<PeerResult> {
+    None
+}
+
+/// Fits the exponent over the cubes cases of 10 000 bodies and more.
+pub fn scaling(results: &[CaseResult]) -> Option<Scaling> {
+    let mut points: Vec<(usize, f64)> = results
+        .iter()
+        .filter(|r| r.scene == "cubes" && r.skipped.is_none() && r.bodies >= 10_000 && r.median_ms_per_step.is_finite())
+        .map(|r| (r.bodies, r.median_ms_per_step))
+        .collect();
+    points.sort_by_key(|p| p.0);
+    points.dedup_by_key(|p| p.0);
+    if points.len() < 2 {
+        return None;
+    }
+    let xs: Vec<f64> = points.iter().map(|p| (p.0 as f64).ln()).collect();
+    let ys: Vec<f64> = points.iter().map(|p| p.1.ln()).collect();
+    let k = xs.len() as f64;
+    let (mx, my) = (xs.iter().sum::<f64>() / k, ys.iter().sum::<f64>() / k);
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
+    let per: Vec<f64> = points.iter().map(|p| p.1 / p.0 as f64).collect();
+    let spread = per.iter().cloned().fold(f64::MIN, f64::max) / per.iter().cloned().fold(f64::MAX, f64::min);
+    Some(Scaling { points, exponent: sxy / sxx, spread })
+}
+
+fn targets(report: &Report) -> Vec<Target> {
+    let cubes = |n: usize| report.cases.iter().find(|r| r.scene == "cubes" && r.bodies == n && r.skipped.is_none());
+    let mut out = Vec::new();
+    let t10 = "10 000 cubes (300 steps): faster per step than rapier3d";
+    out.push(match cubes(10_000) {
+        Some(r) => match &r.peer {
+            Some(p) => Target {
+                target: t10.into(),
+                met: Some(r.median_ms_per_step < p.median_ms_per_step),
+                measured: format!(
+                    "{:.2} ms/step vs rapier {:.2} ms/step ({:.2}x) over {} steps",
+                    r.median_ms_per_step, p.median_ms_per_step, p.speedup, r.steps
+                ),
+            },
+            None => Target { target: t10.into(), met: None, measured: format!("{:.2} ms/step; no peer run", r.median_ms_per_step) },
+        },
+        None => Target { target: t10.into(), met: None, measured: "not run".into() },
+    });
+    let t100 = "100 000 cubes: >= 5x rapier3d's throughput and >= 2M body-steps/s";
+    out.push(match cubes(100_000) {
+        Some(r) => {
+            let fast = r.body_steps_per_s >= 2e6;
+            match &r.peer {
+                Some(p) => Target {
+                    target: t100.into(),
+                    met: Some(fast && p.speedup >= 5.0),
+                    measured: format!("{:.2}x rapier, {:.2}M body-steps/s", p.speedup, r.body_steps_per_s / 1e6),
+                },
+                None => Target {
+                    target: t100.into(),
+                    met: if fast { None } else { Some(false) },
+                    measured: format!("{:.2}M body-steps/s; no peer run", r.body_steps_per_s / 1e6),
+                },
+            }
+        }
+        None => Target { target: t100.into(), met: None, measured: "not run".into() },
+    });
+    let largest = report.cases.iter().filter(|r| r.scene == "cubes" && r.skipped.is_none()).max_by_key(|r| r.bodies);
+    let tint = "integrate pass within 2x of a memory-bound copy of the state";
+    out.push(match largest.and_then(|r| Some((r, r.integrate_ms_per_pass?, r.copy_ms_per_pass?))) {
+        Some((r, i, c)) => Target {
+            target: tint.into(),
+            met: Some(i <= 2.0 * c),
+            measured: format!("{}: integrate {:.3} ms/pass vs copy {:.3} ms/pass ({:.2}x)", r.case, i, c, i / c),
+        },
+        None => Target { target: tint.into(), met: None, measured: "not profiled".into() },
+    });
+    let tmem = "GPU memory <= 512 B/body (grid and contacts included)";
+    out.push(match largest {
+        Some(r) => Target {
+            target: tmem.into(),
+            met: Some(r.gpu_bytes_per_body <= 512.0),
+            measured: format!(
+                "{}: {:.0} B/body allocated ({} B/body by bytes_per_body)",
+                r.case, r.gpu_bytes_per_body, report.bytes_per_body
+            ),
+        },
+        None => Target { target: tmem.into(), met: None, measured: "not run".into() },
+    });
+    let tscale = "10k to 1M: cost per body-step flat within 1.5x";
+    out.push(match &report.scaling {
+        Some(s) => Target {
+            target: tscale.into(),
+            met: Some(s.spread <= 1.5 && s.points.last().is_some_and(|p| p.0 >= 1_000_000)),
+            measured: format!(
+                "exponent {:.2} over {} to {} bodies, spread {:.2}x{}",
+                s.exponent,
+                s.points[0].0,
+                s.points.last().unwrap().0,
+                s.spread,
+                if s.points.last().unwrap().0 < 1_000_000 { " (1M not reached)" } else { "" }
+            ),
+        },
+        None => Target { target: tscale.into(), met: None, measured: "fewer than two cubes cases of >= 10k bodies".into() },
+    });
+    out
+}
+
+fn fmt_ms(v: f64) -> String {
+    if !v.is_finite() {
+        "-".into()
+    } else if v >= 100.0 {
+        format!("{v:.1}")
+    } else if v >= 1.0 {
+        format!("{v:.2}")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
+fn fmt_rate(v: f64) -> String {
+    if !v.is_finite() {
+        "-".into()
+    } else if v >= 1e6 {
+        format!("{:.2} M", v / 1e6)
+    } else {
+        format!("{:.0} k", v / 1e3)
+    }
+}
+
+/// The report as Markdown tables (readable as plain text too).
+pub fn table(r: &Report) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "\nmachine: {} ({} cores)", r.cpu, r.cores);
+    let _ = writeln!(s, "adapter: {}", r.adapter);
+    let _ = writeln!(
+        s,
+        "limits:  max_storage_buffer_binding_size {} B, max_bodies {}, bytes_per_body {} B; GPU opened in {:.2} s",
+        r.max_storage_buffer_binding_size, r.max_bodies, r.bytes_per_body, r.gpu_open_s
+    );
+    let _ = writeln!(s, "shader cache: {}", r.shader_cache);
+    let _ = writeln!(s, "peer:    {}", r.peer);
+    let _ = writeln!(s, "solver:  {}", r.iterations);
+    let _ = writeln!(s, "command: {}", r.command);
+    let busiest = r.cases.iter().filter_map(|c| c.load_avg).flatten().fold(0.0f64, f64::max);
+    if busiest > r.cores as f64 + 0.5 {
+        let _ = writeln!(
+            s,
+            "warning: the machine was busy (1-minute load average up to {busiest:.1} on {} cores): other work shared the CPU, so every time below is inflated",
+            r.cores
+        );
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "| case | bodies | steps x reps | start-up s | ms/step (median) | body-steps/s | GPU MiB | B/body | rapier ms/step | rapier body-steps/s | speed-up |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for c in &r.cases {
+        if let Some(why) = &c.skipped {
+            let _ = writeln!(s, "| {} | {} | - | - | does not fit | - | - | - | - | - | - |", c.case, c.bodies);
+            let _ = writeln!(s, "|  | ({why}) |||||||||");
+            continue;
+        }
+        let (pm, pr, sp) = match &c.peer {
+            Some(p) => (fmt_ms(p.median_ms_per_step), fmt_rate(p.body_steps_per_s), format!("{:.2}x", p.speedup)),
+            None => ("-".into(), "-".into(), "-".into()),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} x {} | {:.2} | {} | {} | {:.1} | {:.0} | {} | {} | {} |",
+            c.case,
+            c.bodies,
+            c.steps,
+            c.reps,
+            c.startup_s,
+            fmt_ms(c.median_ms_per_step),
+            fmt_rate(c.body_steps_per_s),
+            c.gpu_bytes as f64 / (1u64 << 20) as f64,
+            c.gpu_bytes_per_body,
+            pm,
+            pr,
+            sp
+        );
+    }
+    let source = r.cases.iter().find_map(|c| c.stages.as_ref().map(|st| st.source.clone()));
+    if let Some(source) = source {
+        let _ = writeln!(s, "\nper stage, ms per step ({source}; readback and render by wall clock):\n");
+        let _ = writeln!(
+            s,
+            "| case | broadphase | narrowphase | integrate | solve | restitution | sum of passes | wall ms/step | readback | render 640x480 | integrate/pass | copy/pass | integrate/copy |"
+        );
+        let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        for c in &r.cases {
+            let Some(st) = &c.stages else { continue };
+            let ratio = match (c.integrate_ms_per_pass, c.copy_ms_per_pass) {
+                (Some(i), Some(k)) if k > 0.0 => format!("{:.2}x", i / k),
+                _ => "-".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                c.case,
+                fmt_ms(st.broadphase),
+                fmt_ms(st.narrowphase),
+                fmt_ms(st.integrate),
+                fmt_ms(st.solve),
+                fmt_ms(st.restitution),
+                fmt_ms(st.total),
+                fmt_ms(c.median_ms_per_step),
+                fmt_ms(c.readback_ms),
+                c.render_ms.map_or("-".into(), fmt_ms),
+                c.integrate_ms_per_pass.map_or("-".into(), fmt_ms),
+                c.copy_ms_per_pass.map_or("-".into(), fmt_ms),
+                ratio
+            );
+        }
+    }
+    let _ = writeln!(s, "\nsanity (after the last repetition):\n");
+    let _ = writeln!(
+        s,
+        "| case | iterations x substeps | first step ms | set-up + 1 step s (later worlds) | mean height m | rapier mean height m | max manifolds | overflow | load avg start/end |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---|---:|");
+    for c in r.cases.iter().filter(|c| c.skipped.is_none()) {
+        let _ = writeln!(
+            s,
+            "| {} | {} x {} | {} | {:.2} | {:.3} | {} | {} | {} | {} |",
+            c.case,
+            c.iterations,
+            c.substeps,
+            fmt_ms(c.first_step_ms),
+            c.setup_s,
+            c.mean_height,
+            c.peer.as_ref().map_or("-".into(), |p| format!("{:.3}", p.mean_height)),
+            c.max_contacts,
+            if c.contacts_overflowed { "yes" } else { "no" },
+            c.load_avg.map_or("-".into(), |[a, b]| format!("{a:.1} / {b:.1}"))
+        );
+    }
+    for c in &r.cases {
+        if let Some(n) = &c.note {
+            let _ = writeln!(s, "\nnote: {}: {n}", c.case);
+        }
+    }
+    if let (Some(setup), Some(ms)) = (r.render_setup_s, r.render_ms) {
+        let _ = writeln!(
+            s,
+            "\nrender: the 1000-cube scene, landed, at 640 x 480 (4x MSAA, shadow map, image read back): {} ms/frame; renderer set-up {setup:.2} s",
+            fmt_ms(ms)
+        );
+    }
+    if let Some(sc) = &r.scaling {
+        let pts: Vec<String> = sc.points.iter().map(|(n, ms)| format!("{n}: {:.1} ns/body-step", ms * 1e6 / *n as f64)).collect();
+        let _ = writeln!(
+            s,
+            "\nscaling: time per step ~ bodies^{:.2} (log-log least squares over {}); cost per body-step spread {:.2}x",
+            sc.exponent,
+            pts.join(", "),
+            sc.spread
+        );
+    }
+    let _ = writeln!(s, "\ntargets (issue 6):\n");
+    for t in &r.targets {
+        let mark = match t.met {
+            Some(true) => "met",
+            Some(false) => "MISSED",
+            None => "not measured",
+        };
+        let _ = writeln!(s, "- {}: **{mark}** — {}", t.target, t.measured);
+    }
+    s
+}
+
+/// One row per case.
+pub fn csv(r: &Report) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::from(
+        "case,scene,bodies,steps,reps,skipped,startup_s,first_step_ms,setup_s,median_ms_per_step,body_steps_per_s,\
+         gpu_bytes,gpu_bytes_per_body,stage_source,broadphase_ms,narrowphase_ms,integrate_ms,solve_ms,restitution_ms,\
+         readback_ms,render_ms,integrate_ms_per_pass,copy_ms_per_pass,peer,peer_median_ms_per_step,peer_body_steps_per_s,speedup,adapter\n",
+    );
+    let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x}"));
+    let quote = |t: &str| format!("\"{}\"", t.replace('"', "\"\""));
+    for c in &r.cases {
+        let st = c.stages.as_ref();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            quote(&c.case),
+            c.scene,
+            c.bodies,
+            c.steps,
+            c.reps,
+            quote(c.skipped.as_deref().unwrap_or("")),
+            c.startup_s,
+            c.first_step_ms,
+            c.setup_s,
+            c.median_ms_per_step,
+            c.body_steps_per_s,
+            c.gpu_bytes,
+            c.gpu_bytes_per_body,
+            st.map_or(String::new(), |x| x.source.clone()),
+            opt(st.map(|x| x.broadphase)),
+            opt(st.map(|x| x.narrowphase)),
+            opt(st.map(|x| x.integrate)),
+            opt(st.map(|x| x.solve)),
+            opt(st.map(|x| x.restitution)),
+            c.readback_ms,
+            opt(c.render_ms),
+            opt(c.integrate_ms_per_pass),
+            opt(c.copy_ms_per_pass),
+            quote(&c.peer.as_ref().map_or(String::new(), |p| format!("{} threads={}", p.engine, p.threads))),
+            opt(c.peer.as_ref().map(|p| p.median_ms_per_step)),
+            opt(c.peer.as_ref().map(|p| p.body_steps_per_s)),
+            opt(c.peer.as_ref().map(|p| p.speedup)),
+            quote(&r.adapter)
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exponent_of_a_power_law() {
+        let mk = |n: usize, ms: f64| CaseResult { scene: "cubes".into(), bodies: n, median_ms_per_step: ms, ..result_stub() };
+        let rs = vec![mk(10_000, 2.0), mk(100_000, 20.0), mk(1_000_000, 200.0), mk(1_000, 99.0)];
+        let s = scaling(&rs).unwrap();
+        assert!((s.exponent - 1.0).abs() < 1e-9, "{}", s.exponent);
+        assert!((s.spread - 1.0).abs() < 1e-9);
+        assert_eq!(s.points.len(), 3);
+    }
+
+    #[test]
+    fn memory_covers_the_estimate_and_the_median() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        let scene = scenes::cubes(1000, SEED);
+        // the exact sizes round the hash table up, so never below the per-body estimate less the grid's share
+        assert!(gpu_bytes(&scene) >= (world::bytes_per_body() - 20) * 1000);
+    }
+
+    fn result_stub() -> CaseResult {
+        let c = case("pyramid");
+        blank(&c, &c.scene(), 1, 1)
+    }
+}
