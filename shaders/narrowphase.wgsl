@@ -3,11 +3,13 @@
 // list holds, computes the pair's manifold once (collide.wgsl; against the
 // ground, up to four of a box's deepest corners or a sphere's lowest point)
 // and, if it has points, stores it in the manifold pool in the two bodies'
-// frames. Two boxes get only their separating-axis test here; a face
-// contact is stored pending and clipped by narrowphase_clip, over the pool. Contacts are generated up to a speculative gap (the distance the
-// pair can close in one step), so fast bodies meet walls instead of passing
-// them. An awake partner that moves fast or lies deep inside a sleeping body
-// wakes it (WOKEN_NOW; see pairs.wgsl and integrate.wgsl).
+// frames and lists it in both bodies' contact lists. Two boxes get only
+// their separating-axis test here; a face contact is stored pending and
+// clipped by narrowphase_clip, over the top run of the pool. Contacts are
+// generated up to a speculative gap (the distance the pair can close in one
+// step), so fast bodies meet walls instead of passing them. An awake
+// partner that moves fast or lies deep inside a sleeping body wakes it
+// (WOKEN_NOW; see pairs.wgsl and integrate.wgsl).
 
 fn shape_of(i: u32) -> Shape {
     let s = state_in[i];
@@ -117,10 +119,11 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
 // A slot of the manifold pool for bodies a and b (b may be GROUND), listed
 // in both bodies' lists (in the order the slots are taken; contact_lists
 // sorts them), or NONE when the pool is full (counted in status[4] all the
-// same, so the host grows it; contact_lists keeps the most in status[5]). A face contact left for clipping (`to_clip`)
-// takes the next slot from the top of the pool, any other the next from the
-// bottom, so narrowphase_clip runs over the top run alone; the two never
-// meet, as status[4] hands out no more tickets than the pool has slots.
+// same, so the host grows it; contact_lists keeps the most in status[5]).
+// A face contact left for clipping (`to_clip`) takes the next slot from the
+// top of the pool, any other the next from the bottom, so narrowphase_clip
+// runs over the top run alone; the two never meet, as status[4] hands out
+// no more tickets than the pool has slots.
 fn new_manifold(a: u32, b: u32, to_clip: bool) -> u32 {
     let ticket = atomicAdd(&status[4], 1u);
     if (ticket >= arrayLength(&manifolds)) {
