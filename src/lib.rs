@@ -17,6 +17,7 @@
 
 pub mod bench;
 pub mod gpu;
+pub mod load_error;
 pub mod output;
 pub mod reference;
 pub mod render;
@@ -32,13 +33,11 @@ pub use world::{BodyOutput, World};
 /// Everything that can go wrong, each with a one-line reason.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
+    /// A scene file or an input track (`--input`) that did not load whole.
     #[error("{0}")]
-    Scene(#[from] scene::SceneError),
+    Load(#[from] load_error::LoadError),
     #[error("{0}")]
     Gpu(#[from] gpu::GpuError),
-    /// A scripted input track (`--input`) that did not load whole.
-    #[error("{0}")]
-    Track(#[from] track::TrackError),
     /// The scene does not fit the adapter's limits; nothing was allocated.
     #[error("scene too large: {0}")]
     Capacity(String),

@@ -316,7 +316,7 @@ fn load_scene(path: &Path) -> Result<Scene, Error> {
 fn load_track(path: &Path) -> Result<Track, Error> {
     use verlet::track::TrackError;
     Track::from_path(path).map_err(|e| match e {
-        TrackError::Io { path, error } => Error::Input(format!(
+        TrackError::Io { path, error, .. } => Error::Input(format!(
             "{}: cannot read input track given as --input: {}",
             path.display(),
             error.to_string().replace('\n', " ")

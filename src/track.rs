@@ -42,11 +42,12 @@
 //! field as the scene loader does (`events[2].impulse.body: no body 40 (the
 //! scene has 12 bodies)`), with indices as in the file.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::Deserialize;
 
-use crate::scene::{classify_json_error, one_line, path_string, JsonFault, Obj};
+use crate::load_error::FileKind;
+use crate::scene::{path_string, Obj};
 use crate::world::input::{BodyInput, Point, Wind};
 use crate::{Error, World};
 
@@ -153,34 +154,9 @@ pub struct Track {
     origin: Vec<usize>,
 }
 
-/// Why a track could not be loaded: one line, the field's path first.
-#[derive(Debug, thiserror::Error)]
-pub enum TrackError {
-    #[error("{}: cannot read input track: {}", one_line(&.path.display().to_string()), one_line(&.error.to_string()))]
-    Io { path: PathBuf, error: std::io::Error },
-    #[error("input track, line {line}, column {column}: malformed JSON: {message}")]
-    Syntax { line: usize, column: usize, message: String },
-    /// A field is unknown, missing, of the wrong type or has a bad value.
-    #[error("{field}: {message}")]
-    Invalid { field: String, message: String },
-    /// The file is a scene (it has this top-level key), not a track.
-    #[error("this looks like a scene file (it has {0:?}), not an input track ({{\"events\": [...]}}): a scene goes first, `verlet run SCENE.json --input TRACK.json`")]
-    SceneGiven(String),
-}
-
-impl TrackError {
-    /// The path of the offending field, when the error has one.
-    pub fn field(&self) -> Option<&str> {
-        match self {
-            TrackError::Invalid { field, .. } => Some(field),
-            _ => None,
-        }
-    }
-
-    fn invalid(field: impl Into<String>, message: impl Into<String>) -> TrackError {
-        TrackError::Invalid { field: field.into(), message: message.into() }
-    }
-}
+/// Why a track could not be loaded: the error type it shares with scenes
+/// (`crate::load_error`).
+pub type TrackError = crate::load_error::LoadError;
 
 impl Track {
     /// A track of these events (in any order; sorted stably by time here),
@@ -199,7 +175,7 @@ impl Track {
     /// against a scene by [`Track::check`]).
     pub fn from_json_str(text: &str) -> Result<Track, TrackError> {
         if let Some((line, column, message)) = crate::scene::text_problem(text) {
-            return Err(TrackError::Syntax { line, column, message });
+            return Err(TrackError::Syntax { file: FileKind::Track, line, column, message });
         }
         let mut deserializer = serde_json::Deserializer::from_str(text);
         let Obj(raw): Obj<RawTrack> =
@@ -218,7 +194,11 @@ impl Track {
 
     /// Reads and checks a track file.
     pub fn from_path(path: &Path) -> Result<Track, TrackError> {
-        let text = std::fs::read_to_string(path).map_err(|error| TrackError::Io { path: path.to_path_buf(), error })?;
+        let text = std::fs::read_to_string(path).map_err(|error| TrackError::Io {
+            file: FileKind::Track,
+            path: path.to_path_buf(),
+            error,
+        })?;
         Track::from_json_str(&text)
     }
 
@@ -619,8 +599,5 @@ impl RawEvent {
 // ---------------------------------------------------------------------------
 
 fn json_error(field: Option<String>, inner: serde_json::Error) -> TrackError {
-    match classify_json_error(field, inner, "track") {
-        JsonFault::Invalid { field, message } => TrackError::Invalid { field, message },
-        JsonFault::Syntax { line, column, message } => TrackError::Syntax { line, column, message },
-    }
+    TrackError::from_json(FileKind::Track, field, inner)
 }

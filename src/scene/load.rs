@@ -2,12 +2,13 @@
 //! exactly, then into [`Scene`] with defaults filled in and masses resolved.
 
 use super::*;
+use crate::load_error::FileKind;
 
 impl Scene {
     /// Parses and validates a scene from JSON text.
     pub fn from_json_str(text: &str) -> Result<Scene, SceneError> {
         if let Some((line, column, message)) = text_problem(text) {
-            return Err(SceneError::Syntax { line, column, message });
+            return Err(SceneError::Syntax { file: FileKind::Scene, line, column, message });
         }
         let mut deserializer = serde_json::Deserializer::from_str(text);
         let Obj(raw): Obj<RawScene> = serde_path_to_error::deserialize(&mut deserializer)
@@ -21,7 +22,11 @@ impl Scene {
 
     /// Reads, parses and validates a scene file.
     pub fn from_path(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io { path: path.to_path_buf(), error })?;
+        let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
+            file: FileKind::Scene,
+            path: path.to_path_buf(),
+            error,
+        })?;
         Scene::from_json_str(&text)
     }
 }
@@ -41,13 +46,9 @@ pub(crate) fn text_problem(text: &str) -> Option<(usize, usize, String)> {
     None
 }
 
-/// Turns a serde_json error, and the path of the field it happened in (as
-/// tracked by serde_path_to_error), into a [`SceneError`].
+/// A serde_json error in a scene (see `LoadError::from_json`).
 pub(super) fn json_error(field: Option<String>, inner: serde_json::Error) -> SceneError {
-    match classify_json_error(field, inner, "scene") {
-        JsonFault::Invalid { field, message } => SceneError::Invalid { field, message },
-        JsonFault::Syntax { line, column, message } => SceneError::Syntax { line, column, message },
-    }
+    SceneError::from_json(FileKind::Scene, field, inner)
 }
 
 /// A serde_json error as the JSON loaders (scenes, input tracks) report it.

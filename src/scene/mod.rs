@@ -23,7 +23,7 @@
 //! line. No input makes this module panic.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::Deserialize;
 
@@ -321,55 +321,9 @@ pub struct Camera {
     pub fov_y: f32,
 }
 
-/// Why a scene could not be loaded. The message fits on one line: the
-/// offending field's path, then why.
-#[derive(Debug, thiserror::Error)]
-pub enum SceneError {
-    /// The scene file could not be read (missing, unreadable, not UTF-8).
-    #[error("{}: cannot read scene file: {}", one_line(&.path.display().to_string()), one_line(&.error.to_string()))]
-    Io {
-        /// The file that was being read.
-        path: PathBuf,
-        /// What went wrong.
-        error: std::io::Error,
-    },
-    /// The text is not valid JSON.
-    #[error("line {line}, column {column}: malformed JSON: {message}")]
-    Syntax {
-        /// 1-based line of the error.
-        line: usize,
-        /// 1-based column of the error (0 when the text is empty).
-        column: usize,
-        /// What the parser expected, and in which field if known.
-        message: String,
-    },
-    /// A field is unknown, missing, of the wrong type or has a bad value.
-    #[error("{field}: {message}")]
-    Invalid {
-        /// Path of the field, e.g. `bodies[3].shape.half_extents[1]`.
-        field: String,
-        /// Why it is refused, including the offending value.
-        message: String,
-    },
-}
-
-impl SceneError {
-    /// The path of the offending field, when the error has one.
-    pub fn field(&self) -> Option<&str> {
-        match self {
-            SceneError::Invalid { field, .. } => Some(field),
-            _ => None,
-        }
-    }
-
-    fn invalid(field: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid { field: field.into(), message: message.into() }
-    }
-
-    fn missing(field: impl Into<String>) -> SceneError {
-        SceneError::invalid(field, "is required but missing")
-    }
-}
+/// Why a scene could not be loaded: the error type it shares with input
+/// tracks (`crate::load_error`).
+pub type SceneError = crate::load_error::LoadError;
 
 mod load;
 #[cfg(test)]

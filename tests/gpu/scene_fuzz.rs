@@ -142,6 +142,7 @@ fn well_formed(error: &SceneError) -> Result<(), String> {
             }
         }
         SceneError::Io { .. } => return Err(format!("an I/O error from text: {message:?}")),
+        SceneError::SceneGiven(_) => return Err(format!("a track's error from a scene: {message:?}")),
     }
     Ok(())
 }
