@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use crate::scene::{classify_json_error, one_line, JsonFault};
+use crate::scene::{classify_json_error, one_line, text_problem, JsonFault};
 
 /// Which kind of file an error is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,6 +92,20 @@ impl LoadError {
 
     pub(crate) fn missing(field: impl Into<String>) -> LoadError {
         LoadError::invalid(field, "is required but missing")
+    }
+
+    /// The text of a file of kind `file`, or why it cannot be read.
+    pub(crate) fn read(file: FileKind, path: &std::path::Path) -> Result<String, LoadError> {
+        std::fs::read_to_string(path).map_err(|error| LoadError::Io { file, path: path.to_path_buf(), error })
+    }
+
+    /// Refuses text that is no JSON before parsing it (empty, a byte order
+    /// mark, ...: see `text_problem`), with its line and column.
+    pub(crate) fn check_text(file: FileKind, text: &str) -> Result<(), LoadError> {
+        match text_problem(text) {
+            Some((line, column, message)) => Err(LoadError::Syntax { file, line, column, message }),
+            None => Ok(()),
+        }
     }
 
     /// A serde_json error raised in `field` (as serde_path_to_error tracks

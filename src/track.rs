@@ -174,9 +174,7 @@ impl Track {
     /// Parses and checks a track from JSON text (body indices are checked
     /// against a scene by [`Track::check`]).
     pub fn from_json_str(text: &str) -> Result<Track, TrackError> {
-        if let Some((line, column, message)) = crate::scene::text_problem(text) {
-            return Err(TrackError::Syntax { file: FileKind::Track, line, column, message });
-        }
+        TrackError::check_text(FileKind::Track, text)?;
         let mut deserializer = serde_json::Deserializer::from_str(text);
         let Obj(raw): Obj<RawTrack> =
             serde_path_to_error::deserialize(&mut deserializer).map_err(|error| match scene_key(text) {
@@ -194,12 +192,7 @@ impl Track {
 
     /// Reads and checks a track file.
     pub fn from_path(path: &Path) -> Result<Track, TrackError> {
-        let text = std::fs::read_to_string(path).map_err(|error| TrackError::Io {
-            file: FileKind::Track,
-            path: path.to_path_buf(),
-            error,
-        })?;
-        Track::from_json_str(&text)
+        Track::from_json_str(&TrackError::read(FileKind::Track, path)?)
     }
 
     /// Refuses an event naming a body a scene of `body_count` bodies lacks.

@@ -7,9 +7,7 @@ use crate::load_error::FileKind;
 impl Scene {
     /// Parses and validates a scene from JSON text.
     pub fn from_json_str(text: &str) -> Result<Scene, SceneError> {
-        if let Some((line, column, message)) = text_problem(text) {
-            return Err(SceneError::Syntax { file: FileKind::Scene, line, column, message });
-        }
+        SceneError::check_text(FileKind::Scene, text)?;
         let mut deserializer = serde_json::Deserializer::from_str(text);
         let Obj(raw): Obj<RawScene> = serde_path_to_error::deserialize(&mut deserializer)
             .map_err(|error| json_error(path_string(error.path()), error.into_inner()))?;
@@ -22,12 +20,7 @@ impl Scene {
 
     /// Reads, parses and validates a scene file.
     pub fn from_path(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
-            file: FileKind::Scene,
-            path: path.to_path_buf(),
-            error,
-        })?;
-        Scene::from_json_str(&text)
+        Scene::from_json_str(&SceneError::read(FileKind::Scene, path)?)
     }
 }
 
