@@ -77,7 +77,8 @@ fn snap_of(r: u32) -> EndSnap {
 // fixed. It wakes when an awake body touching it moves faster than
 // WAKE_SPEED or lies more than WAKE_DEPTH inside it, and every body wakes
 // after any user input or edit. BodyState
-// rest_time counts the seconds at rest. Bodies with joints never sleep.
+// rest_time counts the seconds at rest. Bodies on joints sleep and wake as
+// their whole joint island (see solve_joints), held by the joints.
 fn asleep(s: BodyState) -> bool {
     return params.sleep_after > 0.0 && s.rest_time >= params.sleep_after;
 }

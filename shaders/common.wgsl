@@ -95,8 +95,8 @@ struct Params {
     sleep_after: f32,        // seconds at rest before a body sleeps; 0: never (settings.sleeping)
     substep: u32,            // which substep of the step this is (0 first)
     opaque_zero: u32,        // always 0; see `opaque` (integrate.wgsl)
-    _pad4: u32,
-    _pad5: u32,
+    island_count: u32,       // joint islands (solve_joints)
+    joint_sweeps: u32,       // sweeps over each island per solve_joints pass
 }
 
 // A candidate pair found by the broadphase (pairs.wgsl): body a owns it; b
@@ -194,7 +194,7 @@ struct JointRef {
     local_self: vec3<f32>,
     partner: u32,
     local_partner: vec3<f32>,
-    _pad0: u32,
+    body: u32,               // the body at this end
 }
 
 // Hamilton product a * b.

@@ -155,7 +155,11 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     // seconds at rest, this substep included (asleep() is false with
     // sleeping off)
     var rest = 0.0;
-    let resting = (s.pos_low & HELD) != 0u && joint_start[i] == joint_start[i + 1u] && point_speed(s, p) < SLEEP_SPEED;
+    // held by a contact, or by its joints: a joint island sleeps and wakes
+    // as a whole (solve_joints gives every body of it the island's least
+    // rest time)
+    let jointed = joint_start[i] != joint_start[i + 1u];
+    let resting = ((s.pos_low & HELD) != 0u || jointed) && point_speed(s, p) < SLEEP_SPEED;
     if (asleep(s)) {
         if (!wake) {
             rest = s.rest_time;

@@ -208,6 +208,13 @@ impl ContactReport {
 /// four deep owns about 2.5 (2.1 with other cubes, 0.4 with the ground,
 /// measured); both pools grow when a step fills half (`World::fit_pools`).
 pub const PAIRS_PER_BODY: u64 = 6;
+
+/// Gauss-Seidel sweeps over the joints in a substep, spread over its
+/// `iterations` `solve_joints` passes (rounded up). A chain converges in a
+/// few; a bridge pinned taut at both ends and loaded is the slowest case met:
+/// `bridge(20)` with ten boxes on it opens 7.3 mm with 24 sweeps a substep,
+/// 4.3 mm with 48 and 3.6 mm with 64 (issue 14's scenes, default settings).
+pub const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 /// Manifolds the pool holds per body at first (pairs with contact points;
 /// about 2.5 in a settled pile, fewer while bodies fall).
 pub const MANIFOLDS_PER_BODY: u64 = 3;
@@ -243,6 +250,8 @@ pub struct World {
     grid: GridLayout,
     large_count: u32,
     body_count: u32,
+    /// Joint islands (`solve_joints` runs only when there are any).
+    island_count: u32,
     /// Which of `data.states` holds the current state.
     current: usize,
     step: u64,
@@ -316,9 +325,9 @@ impl World {
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let (starts, refs) = joint_lists(scene);
-        let joint_start = with_data("joints/start", bytemuck::cast_slice(&starts));
-        let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&refs));
+        let joints = joint_lists(scene);
+        let joint_start = with_data("joints/start", bytemuck::cast_slice(&joints.starts));
+        let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&joints.refs));
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: PARAMS_STRIDE * MAX_BATCH as u64,
@@ -361,6 +370,7 @@ impl World {
             grid,
             large_count: large.len() as u32,
             body_count: n as u32,
+            island_count: joints.islands,
             current: 0,
             step: 0,
             time: 0.0,
@@ -513,7 +523,8 @@ impl World {
                     sleep_after: if s.sleeping { crate::scene::SLEEP_AFTER } else { 0.0 },
                     substep: substep as u32,
                     opaque_zero: 0,
-                    ..Default::default()
+                    island_count: self.island_count,
+                    joint_sweeps: JOINT_SWEEPS_PER_SUBSTEP.div_ceil(s.iterations.max(1)),
                 };
                 let at = slot * PARAMS_STRIDE as usize;
                 slots[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
@@ -556,6 +567,9 @@ impl World {
             plan.push((Stage::Integrate, sub));
             for _ in 0..self.settings.iterations {
                 plan.extend([(Stage::SolveContacts, sub), (Stage::Solve, sub)]);
+                if self.island_count > 0 {
+                    plan.push((Stage::SolveJoints, sub));
+                }
             }
             plan.extend([(Stage::RestitutionContacts, sub), (Stage::Restitution, sub)]);
         }
@@ -580,7 +594,8 @@ impl World {
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(stage.name()), timestamp_writes: timestamps });
         pass.set_pipeline(self.pipelines.pipeline(stage));
         let groups = self.data.bind_groups.as_ref().expect("made with the buffers");
-        pass.set_bind_group(0, &groups[self.current], &offset);
+        let group = if stage.edits_in_place() { 1 - self.current } else { self.current };
+        pass.set_bind_group(0, &groups[group], &offset);
         match stage.over() {
             Over::Pairs => pass.dispatch_workgroups_indirect(&self.data.dispatch, 0),
             Over::Manifolds => pass.dispatch_workgroups_indirect(&self.data.dispatch, 16),
@@ -700,6 +715,7 @@ impl World {
             Over::ScanBlocks => self.grid.hash_size.div_ceil(SCAN_BLOCK),
             Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_BLOCK),
             Over::One => 1,
+            Over::Islands => self.island_count.div_ceil(WORKGROUP),
             Over::Pairs | Over::Manifolds => unreachable!("dispatched indirectly"),
         };
         n.max(1)

@@ -103,8 +103,10 @@ pub struct Params {
     /// bits with it so that the driver cannot fold TwoSum's `(a + b) - a`
     /// back to `b` (Mesa's optimiser does, for operations not marked exact).
     pub opaque_zero: u32,
-    pub _pad4: u32,
-    pub _pad5: u32,
+    /// Joint islands `solve_joints` sweeps (see `joint_lists`).
+    pub island_count: u32,
+    /// Gauss-Seidel sweeps over every joint island per `solve_joints` pass.
+    pub joint_sweeps: u32,
 }
 
 /// A candidate pair (8 bytes); see `Pair` in common.wgsl.
@@ -203,14 +205,15 @@ pub struct BodyContact {
 
 /// One end of a ball joint as the body at that end sees it (32 bytes): its
 /// anchor in its own frame, and the partner's anchor in the partner's frame
-/// (in world coordinates when the partner is `WORLD`).
+/// (in world coordinates when the partner is `WORLD`); `body` is the body
+/// at this end (see `joint_lists`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct JointRef {
     pub local_self: [f32; 3],
     pub partner: u32,
     pub local_partner: [f32; 3],
-    pub _pad0: u32,
+    pub body: u32,
 }
 
 /// The partner of a joint pinned to the world (`WORLD` in WGSL).

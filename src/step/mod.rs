@@ -7,8 +7,10 @@
 //!    axis); `contact_lists` sorts each body's list into pair order; `narrowphase_clip`
 //!    clips the face contacts, over the top run of the pool
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
-//! 5. `solve_contacts`, `solve` — `iterations` Jacobi sweeps of corrective snaps:
-//!    per manifold what it asks of its bodies, then per body the sum (shaders/solve.wgsl)
+//! 5. `solve_contacts`, `solve`, `solve_joints` — `iterations` sweeps of corrective snaps:
+//!    per manifold what it asks of its bodies, then per body the sum (Jacobi), then per
+//!    joint island its joints in turn (Gauss-Seidel; only in scenes with joints)
+//!    (shaders/solve.wgsl)
 //! 6. `restitution_contacts`, `restitution` — bounce and dynamic friction, by
 //!    rewriting the previous pose, in the same two halves (shaders/restitution.wgsl)
 //!
@@ -42,6 +44,7 @@ pub enum Stage {
     Integrate,
     SolveContacts,
     Solve,
+    SolveJoints,
     RestitutionContacts,
     Restitution,
 }
@@ -63,6 +66,8 @@ pub enum Over {
     /// The manifolds in the pool: an indirect dispatch whose size
     /// `contact_lists` wrote (status[12..15], copied to `dispatch` + 16).
     Manifolds,
+    /// The joint islands (see `joint_lists`).
+    Islands,
 }
 
 /// The buffers of the step's bind group, by binding (shaders/bindings.wgsl,
@@ -121,7 +126,7 @@ impl Buffer {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 20] = [
+    pub const ALL: [Stage; 21] = [
         Stage::GridClear,
         Stage::GridCount,
         Stage::GridScanBlocks,
@@ -140,6 +145,7 @@ impl Stage {
         Stage::Integrate,
         Stage::SolveContacts,
         Stage::Solve,
+        Stage::SolveJoints,
         Stage::RestitutionContacts,
         Stage::Restitution,
     ];
@@ -166,6 +172,7 @@ impl Stage {
             Stage::Integrate => "integrate",
             Stage::SolveContacts => "solve_contacts",
             Stage::Solve => "solve",
+            Stage::SolveJoints => "solve_joints",
             Stage::RestitutionContacts => "restitution_contacts",
             Stage::Restitution => "restitution",
         }
@@ -189,7 +196,7 @@ impl Stage {
             Stage::PairsCount | Stage::PairsWrite => shaders::PAIRS_PASS,
             Stage::Narrowphase | Stage::ContactLists | Stage::NarrowphaseClip => shaders::NARROWPHASE_PASS,
             Stage::Integrate => shaders::INTEGRATE_PASS,
-            Stage::SolveContacts | Stage::Solve => shaders::SOLVE_PASS,
+            Stage::SolveContacts | Stage::Solve | Stage::SolveJoints => shaders::SOLVE_PASS,
             Stage::RestitutionContacts | Stage::Restitution => shaders::RESTITUTION_PASS,
             _ => shaders::GRID_PASS,
         }
@@ -223,7 +230,8 @@ impl Stage {
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Integrate => &[Params, Props, StateIn, Status, JointStart, PairMeta],
             Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status],
-            Stage::Solve => &[Params, Props, StateIn, Snaps, JointStart, JointRefs, PairMeta, BodyPairs],
+            Stage::Solve => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs],
+            Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
             Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status],
             Stage::Restitution => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs],
         }
@@ -246,7 +254,7 @@ impl Stage {
             Stage::NarrowphaseClip => &[Manifolds, PairMeta],
             Stage::Integrate => &[StateOut, Vel0, Status, PairMeta],
             Stage::SolveContacts | Stage::RestitutionContacts => &[Snaps, Manifolds],
-            Stage::Solve | Stage::Restitution => &[StateOut],
+            Stage::Solve | Stage::SolveJoints | Stage::Restitution => &[StateOut],
         }
     }
 
@@ -263,7 +271,7 @@ impl Stage {
         match self {
             s if s.is_broadphase() => Part::Broadphase,
             Stage::Integrate => Part::Integrate,
-            Stage::SolveContacts | Stage::Solve => Part::Solve,
+            Stage::SolveContacts | Stage::Solve | Stage::SolveJoints => Part::Solve,
             Stage::RestitutionContacts | Stage::Restitution => Part::Restitution,
             _ => Part::Narrowphase,
         }
@@ -273,6 +281,13 @@ impl Stage {
     /// bodies' pair counts (its override constant SCAN_PAIRS).
     pub fn scans_pairs(self) -> bool {
         matches!(self, Stage::PairsScanBlocks | Stage::PairsScanSums | Stage::PairsScanAdd)
+    }
+
+    /// Whether the pass edits the current state in place: it is bound
+    /// through the bind group whose state_out is the current state (the one
+    /// the pass before it wrote), and nothing flips.
+    pub fn edits_in_place(self) -> bool {
+        self == Stage::SolveJoints
     }
 
     /// Whether the pass writes state_out (so the current state flips).
@@ -288,6 +303,7 @@ impl Stage {
             Stage::PairsScanBlocks => Over::BodyScanBlocks,
             Stage::Narrowphase => Over::Pairs,
             Stage::NarrowphaseClip | Stage::SolveContacts | Stage::RestitutionContacts => Over::Manifolds,
+            Stage::SolveJoints => Over::Islands,
             _ => Over::Bodies,
         }
     }

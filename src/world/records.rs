@@ -88,21 +88,44 @@ pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> B
     }
 }
 
-/// Each body's ball-joint ends, as CSR lists: body i's are
-/// `refs[starts[i]..starts[i + 1]]`, in the order the joints are listed.
-pub fn joint_lists(scene: &Scene) -> (Vec<u32>, Vec<JointRef>) {
+/// The ball joints as the GPU holds them (`joints/start`, `joints/refs`).
+///
+/// - Each body's joint ends, as CSR lists: body i's are
+///   `refs[starts[i]..starts[i + 1]]`, in the order the joints are listed
+///   (the pair pass skips jointed pairs, integrate keeps jointed bodies
+///   awake).
+/// - After them, the joint islands `solve_joints` sweeps: island k's joints
+///   are `refs[starts[n + 1 + k]..starts[n + 2 + k]]` (n bodies), each once,
+///   seen from its `body` end. An island is a set of movable bodies joined
+///   to each other (fixed bodies and the world join nothing: a joint to one
+///   belongs to its movable body's island), its joints ordered outward from
+///   where it is held (breadth first from the bodies joined to the world or
+///   a fixed body, else from its lowest body), so a forward sweep carries a
+///   correction from the anchor to the free ends and a backward one back.
+///   Joints between two fixed bodies are left out: nothing can move them.
+pub struct JointLists {
+    pub starts: Vec<u32>,
+    pub refs: Vec<JointRef>,
+    pub islands: u32,
+}
+
+pub fn joint_lists(scene: &Scene) -> JointLists {
     let n = scene.bodies.len();
+    let movable = |b: i32| b >= 0 && !scene.bodies[b as usize].fixed;
+    let end = |j: &crate::scene::Joint, me: usize| {
+        let other = j.bodies[1 - me];
+        JointRef {
+            local_self: j.anchors[me],
+            partner: if other < 0 { WORLD } else { other as u32 },
+            local_partner: j.anchors[1 - me],
+            body: j.bodies[me] as u32,
+        }
+    };
     let mut per_body: Vec<Vec<JointRef>> = vec![Vec::new(); n];
-    let side = |body: i32| if body < 0 { WORLD } else { body as u32 };
     for j in &scene.joints {
-        for (me, other) in [(0, 1), (1, 0)] {
+        for me in 0..2 {
             if j.bodies[me] >= 0 {
-                per_body[j.bodies[me] as usize].push(JointRef {
-                    local_self: j.anchors[me],
-                    partner: side(j.bodies[other]),
-                    local_partner: j.anchors[other],
-                    _pad0: 0,
-                });
+                per_body[j.bodies[me] as usize].push(end(j, me));
             }
         }
     }
@@ -113,7 +136,75 @@ pub fn joint_lists(scene: &Scene) -> (Vec<u32>, Vec<JointRef>) {
         refs.extend(list);
     }
     starts.push(refs.len() as u32);
-    (starts, refs)
+
+    // the joints each movable body takes part in, by joint index
+    let mut touching: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (k, j) in scene.joints.iter().enumerate() {
+        for b in j.bodies {
+            if movable(b) {
+                touching[b as usize].push(k);
+            }
+        }
+    }
+    // roots first: bodies held by the world or a fixed body, in index order
+    let held = |b: usize| touching[b].iter().any(|&k| scene.joints[k].bodies.iter().any(|&o| !movable(o)));
+    let mut seeds: Vec<usize> = (0..n).filter(|&b| !touching[b].is_empty() && held(b)).collect();
+    seeds.extend((0..n).filter(|&b| !touching[b].is_empty() && !held(b)));
+    let mut island_of = vec![u32::MAX; n];
+    let mut joint_done = vec![false; scene.joints.len()];
+    let mut islands = 0u32;
+    let mut queue = std::collections::VecDeque::new();
+    let mut island_starts = Vec::new();
+    for seed in seeds {
+        if island_of[seed] != u32::MAX {
+            continue;
+        }
+        // this seed's island: every root in it starts the breadth-first walk
+        island_starts.push(refs.len() as u32);
+        let mut members = vec![seed];
+        island_of[seed] = islands;
+        let mut at = 0;
+        while at < members.len() {
+            for &k in &touching[members[at]] {
+                for b in scene.joints[k].bodies {
+                    if movable(b) && island_of[b as usize] == u32::MAX {
+                        island_of[b as usize] = islands;
+                        members.push(b as usize);
+                    }
+                }
+            }
+            at += 1;
+        }
+        members.sort_unstable();
+        queue.extend(members.iter().copied().filter(|&b| held(b)));
+        if queue.is_empty() {
+            queue.push_back(members[0]);
+        }
+        let mut reached = vec![false; n];
+        for &b in &queue {
+            reached[b] = true;
+        }
+        while let Some(b) = queue.pop_front() {
+            for &k in &touching[b] {
+                if joint_done[k] {
+                    continue;
+                }
+                joint_done[k] = true;
+                let j = &scene.joints[k];
+                let me = if j.bodies[0] == b as i32 { 0 } else { 1 };
+                refs.push(end(j, me));
+                let other = j.bodies[1 - me];
+                if movable(other) && !reached[other as usize] {
+                    reached[other as usize] = true;
+                    queue.push_back(other as usize);
+                }
+            }
+        }
+        islands += 1;
+    }
+    island_starts.push(refs.len() as u32);
+    starts.extend(island_starts);
+    JointLists { starts, refs, islands }
 }
 
 /// How far each joint has opened (m): the distance between its two anchors.

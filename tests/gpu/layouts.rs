@@ -61,11 +61,11 @@ fn shared_structs_match_member_by_member() {
             sleep_after,
             substep,
             opaque_zero,
-            _pad4,
-            _pad5
+            island_count,
+            joint_sweeps
         }
     );
-    check_layout!(common, JointRef { local_self, partner, local_partner, _pad0 });
+    check_layout!(common, JointRef { local_self, partner, local_partner, body });
     check_layout!(common, Pair { a, b });
     check_layout!(common, ContactPoint { local_a, pushed, local_b, _pad0 });
     check_layout!(common, ContactManifold { normal, count, a, b, clip_face, pair, points });

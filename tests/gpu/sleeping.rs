@@ -2,7 +2,8 @@
 //! has been slower than 5 cm/s at every point for half a second while
 //! touching something is held still; it wakes when an awake body touching it
 //! moves faster than 20 cm/s, and every body wakes after any input or edit.
-//! Bodies with joints never sleep; free-flying bodies never sleep.
+//! Bodies on joints sleep and wake with their whole joint island; free-flying
+//! bodies and islands never sleep.
 
 use crate::common::{v3, world};
 use verlet::scene::{Joint, WORLD};
@@ -88,15 +89,67 @@ fn a_falling_ball_wakes_a_sleeping_box_and_comes_to_rest_on_it() {
     assert!(after[0].asleep && after[1].asleep, "both should sleep again: {after:?}");
 }
 
+/// Three boxes lying on the ground in a row, joined at their top edges,
+/// the last of them struck later by a falling ball.
+fn joined_row() -> verlet::Scene {
+    let mut scene = scenes::stack(0);
+    scene.bodies = (0..3).map(|k| box_body([0.5; 3], [k as f32 * 1.05, 0.5, 0.0])).collect();
+    scene.joints = (0..2).map(|k| Joint { bodies: [k, k + 1], anchors: [[0.525, 0.5, 0.0], [-0.525, 0.5, 0.0]] }).collect();
+    scene.bodies.push(sphere_body(0.25, [2.1, 12.0, 0.0])); // lands at about 1.5 s, at 14 m/s
+    scene
+}
+
 #[test]
-fn a_body_with_a_joint_never_sleeps() {
-    // a box lying on the ground, held by a ball joint at a top corner: at rest
-    // and touching, it would sleep but for the joint
+fn a_joint_island_sleeps_and_wakes_as_one() {
+    let scene = joined_row();
+    let Some(mut w) = world(&scene) else { return };
+    let (mut slept, mut woke) = (None, None);
+    for step in 1..=150u32 {
+        w.step(1).unwrap();
+        let s = w.read_state().unwrap();
+        let row: Vec<bool> = s[..3].iter().map(|b| b.asleep).collect();
+        assert!(row.iter().all(|&a| a == row[0]), "step {step}: the joined boxes sleep apart: {row:?}");
+        if row[0] && slept.is_none() {
+            slept = Some(step);
+        }
+        if !row[0] && slept.is_some() && woke.is_none() {
+            woke = Some(step);
+        }
+    }
+    eprintln!("joined row: asleep from step {slept:?}, woken by the ball at step {woke:?}");
+    assert!(slept.is_some_and(|s| s < 80), "the joined boxes at rest did not sleep before the ball came: {slept:?}");
+    assert!(woke.is_some(), "the ball's impact on the last box did not wake the row");
+    w.step(300).unwrap();
+    assert!(w.read_state().unwrap()[..3].iter().all(|b| b.asleep), "the row did not sleep again");
+}
+
+#[test]
+fn a_joint_island_flying_free_never_sleeps() {
+    // no gravity, nothing to touch, no joint to the world: two joined boxes
+    // drifting at 1 cm/s for 3 s are awake and 3 cm further
+    let mut scene = scenes::stack(0);
+    scene.settings.gravity = [0.0; 3];
+    scene.bodies = (0..2).map(|k| box_body([0.5; 3], [k as f32 * 1.05, 5.0, 0.0])).collect();
+    for b in &mut scene.bodies {
+        b.linear_velocity = [0.01, 0.0, 0.0];
+    }
+    scene.joints = vec![Joint { bodies: [0, 1], anchors: [[0.525, 0.0, 0.0], [-0.525, 0.0, 0.0]] }];
+    let Some(mut w) = world(&scene) else { return };
+    w.step(180).unwrap();
+    let s = w.read_state().unwrap();
+    assert!(!s[0].asleep && !s[1].asleep);
+    assert!((s[0].position[0] - 0.03).abs() < 1e-4, "drifted to x = {} (3 cm expected)", s[0].position[0]);
+}
+
+#[test]
+fn a_box_hanging_still_on_a_joint_sleeps() {
+    // a box lying on the ground, held by a ball joint at a top corner: at
+    // rest, held by the ground and the joint, it sleeps
     let mut scene = scenes::stack(1);
     scene.joints = vec![Joint { bodies: [0, WORLD], anchors: [[0.5, 0.5, 0.5], [0.5, 1.0, 0.5]] }];
     let Some(mut w) = world(&scene) else { return };
     w.step(120).unwrap();
     let s = w.read_state().unwrap()[0];
     assert!(v3(s.position).distance(glam::Vec3::new(0.0, 0.5, 0.0)) < 0.01, "{s:?}");
-    assert!(!s.asleep, "a jointed body fell asleep");
+    assert!(s.asleep, "a jointed body at rest stayed awake");
 }
