@@ -496,6 +496,7 @@ impl World {
         let mut slots = vec![0u8; PARAMS_STRIDE as usize * dts.len() * substeps];
         let mut dt_prev = self.dt_prev;
         let mut slot = 0;
+        let mut elapsed = self.time;
         for (k, &dt) in dts.iter().enumerate() {
             let h = dt / substeps as f32;
             // NO_FAULT is reserved: the step index saturates just below it
@@ -525,12 +526,15 @@ impl World {
                     opaque_zero: 0,
                     island_count: self.island_count,
                     joint_sweeps: JOINT_SWEEPS_PER_SUBSTEP.div_ceil(s.iterations.max(1)),
+                    elapsed: (elapsed + (substep + 1) as f64 * h as f64) as f32,
+                    ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;
                 slots[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
                 dt_prev = h;
                 slot += 1;
             }
+            elapsed += dt as f64;
         }
         self.gpu.queue.write_buffer(&self.data.params, 0, &slots);
         slot

@@ -103,6 +103,9 @@ pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> B
 ///   a fixed body, else from its lowest body), so a forward sweep carries a
 ///   correction from the anchor to the free ends and a backward one back.
 ///   Joints between two fixed bodies are left out: nothing can move them.
+/// - After the island starts, the gap each island joint had in the scene
+///   as given (m, f32 bits, in the islands' order): `solve_joints` closes
+///   what a scene starts with at a bounded speed.
 pub struct JointLists {
     pub starts: Vec<u32>,
     pub refs: Vec<JointRef>,
@@ -203,7 +206,22 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
         islands += 1;
     }
     island_starts.push(refs.len() as u32);
+    let first_island_ref = island_starts[0] as usize;
     starts.extend(island_starts);
+    // the scene's own gaps, from its poses as given
+    let anchor = |body: u32, local: [f32; 3]| {
+        if body == WORLD {
+            return DVec3::from_array(local.map(f64::from));
+        }
+        let b = &scene.bodies[body as usize];
+        let o = b.orientation.map(f64::from);
+        let q = DQuat::from_xyzw(o[0], o[1], o[2], o[3]).normalize();
+        DVec3::from_array(b.position.map(f64::from)) + q * DVec3::from_array(local.map(f64::from))
+    };
+    for r in &refs[first_island_ref..] {
+        let gap = (anchor(r.partner, r.local_partner) - anchor(r.body, r.local_self)).length() as f32;
+        starts.push(gap.to_bits());
+    }
     JointLists { starts, refs, islands }
 }
 

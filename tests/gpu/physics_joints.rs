@@ -221,3 +221,48 @@ fn a_chain_hung_by_both_ends_settles_into_a_catenary() {
         assert!(worst < 0.02 * span, "{label}: deviates {worst} m from the catenary (span {span} m)");
     }
 }
+
+/// The fastest body over `steps` steps (m/s), and the widest joint gap at the end.
+fn fastest_over(scene: &Scene, steps: u32) -> Option<(f32, f32)> {
+    let mut w = world(scene)?;
+    let mut fastest = 0.0f32;
+    for _ in 0..steps {
+        w.step(1).unwrap();
+        let state = w.read_state().unwrap(); // refuses NaN and faults
+        fastest = state.iter().map(|b| v3(b.linear_velocity).length()).fold(fastest, f32::max);
+    }
+    let widest = joint_gaps(scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max);
+    Some((fastest, widest))
+}
+
+/// Issue 16: joint error a scene starts with is closed at a bounded speed,
+/// as overlap is (3 m/s a joint), not snapped shut in one substep. No
+/// gravity: only the joints move anything.
+#[test]
+fn joints_a_scene_leaves_open_close_at_a_bounded_speed() {
+    // four boxes 1.5 m apart in a square, joined in a ring whose joints
+    // want them 1 m apart: each joint 1 m open (48 m/s when snapped shut)
+    let mut ring = scenes::stack(0);
+    ring.ground = None;
+    ring.settings.gravity = [0.0; 3];
+    ring.bodies = [(0.0, 0.0), (1.5, 0.0), (1.5, 1.5), (0.0, 1.5)].iter().map(|&(x, z)| box_body([0.25; 3], [x, 3.0, z])).collect();
+    ring.joints = (0..4).map(|k| Joint { bodies: [k, (k + 1) % 4], anchors: [[0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]] }).collect();
+    let Some((fastest, widest)) = fastest_over(&ring, 120) else { return };
+    eprintln!("ring left 1 m open: fastest body {fastest} m/s; widest gap after 2 s {widest} m");
+    assert!(fastest < 4.0, "the ring closed at {fastest} m/s");
+    assert!(widest < 0.005, "the ring did not close: a gap of {widest} m");
+
+    // a chain of three 0.5 m boxes pinned to the world 3 m apart: it cannot
+    // reach (30 m/s when the joints were relaxed Jacobi style)
+    let mut taut = ring.clone();
+    taut.bodies = (0..3).map(|k| box_body([0.25; 3], [0.25 + 0.5 * k as f32, 3.0, 0.0])).collect();
+    taut.joints = vec![
+        Joint { bodies: [0, -1], anchors: [[-0.25, 0.0, 0.0], [0.0, 3.0, 0.0]] },
+        Joint { bodies: [0, 1], anchors: [[0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]] },
+        Joint { bodies: [1, 2], anchors: [[0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]] },
+        Joint { bodies: [2, -1], anchors: [[0.25, 0.0, 0.0], [3.0, 3.0, 0.0]] },
+    ];
+    let Some((fastest, _)) = fastest_over(&taut, 120) else { return };
+    eprintln!("chain pinned beyond its reach: fastest body {fastest} m/s");
+    assert!(fastest < 3.0, "the unreachable pins threw the chain at {fastest} m/s");
+}
