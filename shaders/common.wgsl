@@ -172,11 +172,10 @@ struct PairMeta {
     reach: f32,
 }
 
-// pair_meta[i].woken bits: set by the narrowphase when an awake partner
+// pair_meta[i].woken bits, WOKEN_NOW and WOKEN_LAST (shared with Rust,
+// whose snapshots keep them): set by the narrowphase when an awake partner
 // wakes a sleeper; moved to WOKEN_LAST by integrate, which wakes the body
 // one step later, once the pair list holds all of its pairs again.
-const WOKEN_NOW: u32 = 1u;
-const WOKEN_LAST: u32 = 2u;
 
 // A body's reference to one of its manifolds, as contact_lists leaves it in
 // the body's list: the manifold's index and which end of it the body is.

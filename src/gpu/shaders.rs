@@ -31,6 +31,8 @@ pub fn shared_constants() -> String {
         ("LARGE_BODY", LARGE_BODY),
         ("WORKGROUP", WORKGROUP),
         ("SCAN_BLOCK", SCAN_BLOCK),
+        ("WOKEN_NOW", WOKEN_NOW),
+        ("WOKEN_LAST", WOKEN_LAST),
         ("NO_FAULT", NO_FAULT),
         ("FAULT_NON_FINITE", FaultKind::NonFinite as u32),
         ("FAULT_FAR", FaultKind::TooFar as u32),

@@ -221,6 +221,12 @@ pub struct JointRef {
     pub body: u32,
 }
 
+/// `PairMeta::woken` bits (the same names in WGSL): the narrowphase found an
+/// awake partner waking this sleeper (`WOKEN_NOW`), moved to `WOKEN_LAST`
+/// by the step's integration; the sleeper wakes at the next step.
+pub const WOKEN_NOW: u32 = 1;
+pub const WOKEN_LAST: u32 = 2;
+
 /// The partner of a joint pinned to the world (`WORLD` in WGSL).
 pub const WORLD: u32 = u32::MAX;
 

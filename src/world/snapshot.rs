@@ -1,6 +1,7 @@
 //! Snapshots: a world's whole dynamic state (the current poses with the
-//! displacements and turns from their previous poses, the step counter, the
-//! time and the last substep's length),
+//! displacements and turns from their previous poses, the sleepers an awake
+//! body woke in the last step, the step counter, the time and the last
+//! substep's length),
 //! taken and restored through the API or a small binary file.
 //!
 //! What carries over from one step to the next is exactly this: every pass
@@ -9,19 +10,21 @@
 //! contact lists are rebuilt by each step's narrowphase (their `pushed`
 //! budgets are reset by the integration pass), and the velocities the
 //! restitution pass compares against are written by that step's integration.
-//! Restoring the poses and `dt_prev` therefore continues bit for bit as the
+//! One flag outlives a step: a sleeper the narrowphase found woken wakes at
+//! the next step (`pair_meta[i].woken`, see integrate.wgsl). Restoring the
+//! poses, those flags and `dt_prev` therefore continues bit for bit as the
 //! run the snapshot was taken from (tests/gpu/snapshot.rs checks it).
 //!
 //! A snapshot names the scene it belongs to by a hash of the world's static
 //! data (settings, ground, grid, the bodies' shapes, masses and materials,
 //! and the joints), and restoring it into another scene is refused.
 //!
-//! # File format (version 2, little-endian)
+//! # File format (version 3, little-endian)
 //!
 //! | offset | size | field |
 //! |-------:|-----:|-------|
 //! | 0 | 8 | magic `VRLTSNAP` |
-//! | 8 | 4 | version (u32) = 2 |
+//! | 8 | 4 | version (u32) = 3 |
 //! | 12 | 4 | body count n (u32) |
 //! | 16 | 8 | step counter (u64) |
 //! | 24 | 8 | simulated time, s (f64) |
@@ -29,24 +32,30 @@
 //! | 36 | 4 | reserved, 0 |
 //! | 40 | 8 | scene hash (u64) |
 //! | 48 | 64 n | poses: `BodyState` as on the GPU |
-//! | 48 + 64 n | 8 | FNV-1a 64 of all bytes before it |
+//! | 48 + 64 n | n | each body's wake flags (`PairMeta::woken`: 0, or a sleeper woken) |
+//! | 48 + 65 n | 8 | FNV-1a 64 of all bytes before it |
 //!
-//! 56 bytes plus 64 bytes per body.
+//! 56 bytes plus 65 bytes per body.
 //!
-//! Version 1 held each body's previous position (xyz, and w = 1 if a contact
-//! pushed it) where version 2 holds `disp` and `pos_low`; it is read and
-//! converted: disp = pos - prev_pos (what version 1's velocity was), no
-//! rounding remainder, and the flag as it was. Its run then continues as
-//! this build runs it, not bit for bit as the run it was taken from.
+//! Version 2 is version 3 without the wake flags; it is read with none set
+//! (a sleeper woken in the step before it was taken then sleeps on until
+//! something wakes it again). Version 1 held each body's previous position
+//! (xyz, and w = 1 if a contact pushed it) where version 2 holds `disp` and
+//! `pos_low`; it is read and converted: disp = pos - prev_pos (what version
+//! 1's velocity was), no rounding remainder, and the flag as it was. Their
+//! runs then continue as this build runs them, not bit for bit as the runs
+//! they were taken from. The scene hash covers the joint lists as the GPU
+//! holds them, which since version 3 include the joint islands: a version 1
+//! or 2 snapshot of a scene with joints is refused as another scene's.
 
 use std::path::Path;
 
 use super::World;
-use crate::gpu::types::{BodyState, HELD};
+use crate::gpu::types::{BodyState, PairMeta, HELD, WOKEN_LAST, WOKEN_NOW};
 use crate::Error;
 
 const MAGIC: &[u8; 8] = b"VRLTSNAP";
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 /// The previous-position layout, still read (see the module documentation).
 const VERSION_PREV_POS: u32 = 1;
 const HEADER: usize = 48;
@@ -61,6 +70,9 @@ pub struct Snapshot {
     dt_prev: f32,
     scene_hash: u64,
     states: Vec<BodyState>,
+    /// `PairMeta::woken` of every body (0 but for a sleeper woken in the
+    /// last step, which wakes in the next).
+    woken: Vec<u8>,
 }
 
 impl Snapshot {
@@ -93,9 +105,15 @@ impl Snapshot {
         &self.states
     }
 
+    /// Every body's wake flags (`PairMeta::woken`): not 0 for a sleeper
+    /// woken in the last step, which wakes in the next.
+    pub fn woken(&self) -> &[u8] {
+        &self.woken
+    }
+
     /// The file format of the module documentation.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(HEADER + POSE * self.states.len() + TRAILER);
+        let mut out = Vec::with_capacity(HEADER + (POSE + 1) * self.states.len() + TRAILER);
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&VERSION.to_le_bytes());
         out.extend_from_slice(&(self.states.len() as u32).to_le_bytes());
@@ -107,6 +125,7 @@ impl Snapshot {
         for s in &self.states {
             out.extend_from_slice(bytemuck::bytes_of(s));
         }
+        out.extend_from_slice(&self.woken);
         let sum = fnv1a(FNV_OFFSET, &out);
         out.extend_from_slice(&sum.to_le_bytes());
         out
@@ -124,13 +143,14 @@ impl Snapshot {
         let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
         let f32_at = |at: usize| f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
         let version = u32_at(8);
-        if version != VERSION && version != VERSION_PREV_POS {
+        if !(VERSION_PREV_POS..=VERSION).contains(&version) {
             return Err(format!(
-                "snapshot version {version} is not supported (this build reads versions {VERSION_PREV_POS} and {VERSION})"
+                "snapshot version {version} is not supported (this build reads versions {VERSION_PREV_POS} to {VERSION})"
             ));
         }
         let n = u32_at(12) as usize;
-        let expected = n.checked_mul(POSE).and_then(|p| p.checked_add(HEADER + TRAILER));
+        let per_body = if version == VERSION { POSE + 1 } else { POSE };
+        let expected = n.checked_mul(per_body).and_then(|p| p.checked_add(HEADER + TRAILER));
         if expected != Some(bytes.len()) {
             return Err(format!(
                 "snapshot of {n} bodies should be {} bytes but is {} (truncated or padded)",
@@ -182,7 +202,11 @@ impl Snapshot {
                 }
             })
             .collect();
-        Ok(Snapshot { step, time, dt_prev, scene_hash, states })
+        let woken = if version == VERSION { bytes[HEADER + n * POSE..HEADER + n * (POSE + 1)].to_vec() } else { vec![0; n] };
+        if let Some(i) = woken.iter().position(|&w| u32::from(w) > WOKEN_NOW | WOKEN_LAST) {
+            return Err(format!("snapshot body {i}: wake flags {} are not 0 to 3", woken[i]));
+        }
+        Ok(Snapshot { step, time, dt_prev, scene_hash, states, woken })
     }
 
     /// Writes the snapshot to `path`.
@@ -204,7 +228,8 @@ impl World {
     /// The world's dynamic state (a blocking readback of the current poses).
     pub fn snapshot(&self) -> Result<Snapshot, Error> {
         let states = self.read_raw()?;
-        Ok(Snapshot { step: self.step, time: self.time, dt_prev: self.dt_prev, scene_hash: self.scene_hash()?, states })
+        let woken = self.read_pair_meta()?.iter().take(states.len()).map(|m| m.woken as u8).collect();
+        Ok(Snapshot { step: self.step, time: self.time, dt_prev: self.dt_prev, scene_hash: self.scene_hash()?, states, woken })
     }
 
     /// Puts the world back in the state of `snapshot`, which must have been
@@ -230,12 +255,24 @@ impl World {
         }
         if !snapshot.states.is_empty() {
             self.gpu.queue.write_buffer(&self.data.states[self.current], 0, bytemuck::cast_slice(&snapshot.states));
+            let mut meta = self.read_pair_meta()?;
+            for (m, &w) in meta.iter_mut().zip(&snapshot.woken) {
+                m.woken = u32::from(w);
+            }
+            self.gpu.queue.write_buffer(&self.data.pair_meta, 0, bytemuck::cast_slice(&meta));
         }
         self.gpu.check()?;
         self.step = snapshot.step;
         self.time = snapshot.time;
         self.dt_prev = snapshot.dt_prev;
         Ok(())
+    }
+
+    /// Every body's `PairMeta` (a blocking readback; the last entry, the
+    /// scan's total, left out).
+    fn read_pair_meta(&self) -> Result<Vec<PairMeta>, Error> {
+        let bytes = self.gpu.read_buffer(&self.data.pair_meta, self.body_count as u64 * std::mem::size_of::<PairMeta>() as u64)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
     /// FNV-1a 64 of what a world never changes after start-up: settings,

@@ -105,6 +105,8 @@ fn constants_match() {
         ("LARGE_BODY", LARGE_BODY),
         ("WORKGROUP", WORKGROUP),
         ("SCAN_BLOCK", SCAN_BLOCK),
+        ("WOKEN_NOW", WOKEN_NOW),
+        ("WOKEN_LAST", WOKEN_LAST),
         ("MAX_POINTS", MAX_POINTS),
         ("NONE", NONE),
         ("GROUND", GROUND),
