@@ -92,8 +92,8 @@ pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> B
 ///
 /// - Each body's joint ends, as CSR lists: body i's are
 ///   `refs[starts[i]..starts[i + 1]]`, in the order the joints are listed
-///   (the pair pass skips jointed pairs, integrate keeps jointed bodies
-///   awake).
+///   (the pair pass skips jointed pairs; integrate counts a jointed body
+///   as held up when it decides whether it rests).
 /// - After them, the joint islands `solve_joints` sweeps: island k's joints
 ///   are `refs[starts[n + 1 + k]..starts[n + 2 + k]]` (n bodies), each once,
 ///   seen from its `body` end. An island is a set of movable bodies joined
@@ -158,6 +158,8 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
     let mut islands = 0u32;
     let mut queue = std::collections::VecDeque::new();
     let mut island_starts = Vec::new();
+    // reached by an island's walk (each body belongs to one island)
+    let mut reached = vec![false; n];
     for seed in seeds {
         if island_of[seed] != u32::MAX {
             continue;
@@ -183,7 +185,6 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
         if queue.is_empty() {
             queue.push_back(members[0]);
         }
-        let mut reached = vec![false; n];
         for &b in &queue {
             reached[b] = true;
         }
@@ -291,4 +292,52 @@ pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
     let q4 = |q: DQuat| [q.x as f32, q.y as f32, q.z as f32, q.w as f32];
     let x = v3(x0);
     BodyState { pos: x, rest_time: 0.0, disp: v3(disp), pos_low: if b.fixed { HELD } else { 0 }, rot: q4(q0), prev_rot: q4(prev_q) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Joint;
+    use crate::scenes::{box_body, stack};
+
+    /// Islands: a chain pinned to the world at its far end (ordered outward
+    /// from the pin), a free pair (from its lowest body), a joint between
+    /// two fixed bodies (left out), and each island joint's given gap.
+    #[test]
+    fn joint_lists_split_and_order_the_islands() {
+        let mut scene = stack(0);
+        scene.bodies = (0..6).map(|k| box_body([0.5; 3], [k as f32, 1.0, 0.0])).collect();
+        scene.bodies[4].fixed = true;
+        scene.bodies[5].fixed = true;
+        let j = |a: i32, b: i32| Joint { bodies: [a, b], anchors: [[0.5, 0.0, 0.0], [-0.5, 0.0, 0.0]] };
+        scene.joints = vec![
+            j(0, 1),
+            j(1, 2),
+            Joint { bodies: [2, -1], anchors: [[0.5, 0.0, 0.0], [2.5, 1.0, 0.0]] },
+            j(3, 4), // 3 held by fixed 4
+            j(4, 5), // two fixed bodies: left out
+        ];
+        let lists = joint_lists(&scene);
+        let n = scene.bodies.len();
+        assert_eq!(lists.islands, 2);
+        // per-body ends: two per joint between bodies, one per world joint
+        let per_body = lists.starts[n] as usize;
+        assert_eq!(per_body, 9);
+        let island = |k: usize| {
+            let (from, to) = (lists.starts[n + 1 + k] as usize, lists.starts[n + 2 + k] as usize);
+            lists.refs[from..to].iter().map(|r| (r.body, r.partner)).collect::<Vec<_>>()
+        };
+        // held bodies seed first, in index order: 2 (world), then 3 (fixed
+        // 4); a body's joints in the scene's order
+        assert_eq!(island(0), vec![(2, 1), (2, WORLD), (1, 0)]);
+        assert_eq!(island(1), vec![(3, 4)]);
+        // the gaps as given, after the 3 island starts: the bodies sit where
+        // their anchors meet, so every gap is 0 until a body is moved
+        let gaps: Vec<f32> = lists.starts[n + 4..].iter().map(|&g| f32::from_bits(g)).collect();
+        assert_eq!(gaps.len(), 4);
+        assert!(gaps.iter().all(|&g| g < 1e-6), "{gaps:?}");
+        scene.bodies[0].position[0] -= 0.25;
+        let gaps: Vec<f32> = joint_lists(&scene).starts[n + 4..].iter().map(|&g| f32::from_bits(g)).collect();
+        assert!((gaps[2] - 0.25).abs() < 1e-6, "{gaps:?}"); // joint (1, 0), third in island 0
+    }
 }
