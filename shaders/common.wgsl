@@ -97,10 +97,6 @@ struct Params {
     opaque_zero: u32,        // always 0; see `opaque` (integrate.wgsl)
     island_count: u32,       // joint islands (solve_joints)
     joint_sweeps: u32,       // sweeps over each island per solve_joints pass
-    elapsed: f32,            // seconds simulated at the end of this substep
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 // A candidate pair found by the broadphase (pairs.wgsl): body a owns it; b

@@ -217,8 +217,9 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
 // src/world.rs).
 
 // Close one joint: body j.body and its partner (or the world) move along
-// the gap between the two anchors until it is no wider than `slack`.
-fn close_joint(j: JointRef, slack: f32) {
+// the gap between the two anchors until they meet, or until it has closed
+// by as much as MAX_DEPENETRATION_SPEED allows in this substep.
+fn close_joint(j: JointRef) {
     let a = j.body;
     let joined = j.partner != WORLD;
     let b = select(a, j.partner, joined);
@@ -230,13 +231,24 @@ fn close_joint(j: JointRef, slack: f32) {
     let rb = quat_rotate(sb.rot, j.local_partner);
     let gap = select(j.local_partner, sb.pos + rb, joined) - (sa.pos + ra);
     let dist = length(gap);
+    // The gap the joint had at the previous poses (from the displacements:
+    // no difference of two far-out positions) closes at no more than
+    // MAX_DEPENETRATION_SPEED, as overlap does; what this substep opened
+    // closes whole. A full snap in one substep turns into velocity: a ring
+    // of boxes placed 1 m from where its joints want them was thrown at
+    // 48 m/s, and joints that cannot all close (a loop of the wrong
+    // lengths) fought until a body spun past the fault limit.
+    let moved_a = sa.disp + (ra - quat_rotate(sa.prev_rot, j.local_self));
+    let moved_b = select(vec3<f32>(0.0), sb.disp + (rb - quat_rotate(sb.prev_rot, j.local_partner)), joined);
+    let before = length(gap - (moved_b - moved_a));
+    let bounded = max(before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
     let n = gap / max(dist, 1e-30); // a moves along n, b against it
     let wa = select(effective_inv_mass(pa, sa.rot, ra, n), 0.0, is_fixed(pa));
     let wb = select(0.0, effective_inv_mass(pb, sb.rot, rb, n), joined && !is_fixed(pb));
-    if (dist <= slack + 1e-7 || wa + wb <= 0.0) {
+    if (dist <= bounded + 1e-7 || wa + wb <= 0.0) {
         return;
     }
-    let lambda = (dist - slack) / (wa + wb);
+    let lambda = (dist - bounded) / (wa + wb);
     if (wa > 0.0) {
         let dx = n * (pa.inv_inertia.w * lambda);
         sa.pos = sa.pos + dx;
@@ -297,16 +309,8 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     // count is the island's own (a loop bounded by a uniform alone makes
     // lavapipe compile the kernel again for every dispatch)
     let n = end - first;
-    // the scene's gaps follow the island starts, one per island joint
-    let islands_first = joint_start[params.body_count + 1u];
-    let gaps = params.body_count + params.island_count + 2u;
     for (var t = 0u; t < 2u * n * params.joint_sweeps; t = t + 1u) {
         let r = t % (2u * n);
-        let e = select(first + r, end - 1u - (r - n), r >= n);
-        // the gap the scene gave this joint, closed at MAX_DEPENETRATION_SPEED
-        // as overlap is: a full snap in one substep turns into velocity
-        // (closing a ring of boxes placed 0.5 m apart launched them at 48 m/s)
-        let given = bitcast<f32>(joint_start[gaps + (e - islands_first)]);
-        close_joint(joint_refs[e], max(given - MAX_DEPENETRATION_SPEED * params.elapsed, 0.0));
+        close_joint(joint_refs[select(first + r, end - 1u - (r - n), r >= n)]);
     }
 }

@@ -281,9 +281,9 @@ pub fn gpu_bytes(scene: &Scene) -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
     let (pairs, manifolds) = (n * world::PAIRS_PER_BODY, n * world::MANIFOLDS_PER_BODY);
     // the joint lists (see `joint_lists`) at their largest: an island per
-    // joint, each joint's given gap, three references a joint
+    // joint, three references a joint
     let joint_count = scene.joints.len() as u64;
-    let joints = 4 * (n + 1 + joint_count + 1 + joint_count) + 3 * joint_count * std::mem::size_of::<JointRef>() as u64;
+    let joints = 4 * (n + 1 + joint_count + 1) + 3 * joint_count * std::mem::size_of::<JointRef>() as u64;
     2 * size(n * state)
         + size(n * std::mem::size_of::<BodyProps>() as u64)
         + size(n * std::mem::size_of::<Velocity>() as u64)

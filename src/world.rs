@@ -213,7 +213,7 @@ pub const PAIRS_PER_BODY: u64 = 6;
 /// `iterations` `solve_joints` passes (rounded up). A chain converges in a
 /// few; a bridge pinned taut at both ends and loaded is the slowest case met:
 /// `bridge(20)` with ten boxes on it opens 7.3 mm with 24 sweeps a substep,
-/// 4.3 mm with 48 and 3.6 mm with 64 (issue 14's scenes, default settings).
+/// 4.3 mm with 48 and 2.7 mm with 66 (64 over 3 iterations; default settings).
 pub const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 /// Manifolds the pool holds per body at first (pairs with contact points;
 /// about 2.5 in a settled pile, fewer while bodies fall).
@@ -496,7 +496,6 @@ impl World {
         let mut slots = vec![0u8; PARAMS_STRIDE as usize * dts.len() * substeps];
         let mut dt_prev = self.dt_prev;
         let mut slot = 0;
-        let mut elapsed = self.time;
         for (k, &dt) in dts.iter().enumerate() {
             let h = dt / substeps as f32;
             // NO_FAULT is reserved: the step index saturates just below it
@@ -526,15 +525,12 @@ impl World {
                     opaque_zero: 0,
                     island_count: self.island_count,
                     joint_sweeps: JOINT_SWEEPS_PER_SUBSTEP.div_ceil(s.iterations.max(1)),
-                    elapsed: (elapsed + (substep + 1) as f64 * h as f64) as f32,
-                    ..Default::default()
                 };
                 let at = slot * PARAMS_STRIDE as usize;
                 slots[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
                 dt_prev = h;
                 slot += 1;
             }
-            elapsed += dt as f64;
         }
         self.gpu.queue.write_buffer(&self.data.params, 0, &slots);
         slot

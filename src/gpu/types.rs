@@ -65,7 +65,7 @@ pub struct Velocity {
     pub angular: [f32; 4],
 }
 
-/// Per-step parameters (112 bytes, stored in 256-byte slots).
+/// Per-step parameters (96 bytes, stored in 256-byte slots).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Params {
@@ -107,11 +107,6 @@ pub struct Params {
     pub island_count: u32,
     /// Gauss-Seidel sweeps over every joint island per `solve_joints` pass.
     pub joint_sweeps: u32,
-    /// Seconds simulated at the end of this substep since the world began.
-    pub elapsed: f32,
-    pub _pad0: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
 }
 
 /// A candidate pair (8 bytes); see `Pair` in common.wgsl.

@@ -103,9 +103,6 @@ pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> B
 ///   a fixed body, else from its lowest body), so a forward sweep carries a
 ///   correction from the anchor to the free ends and a backward one back.
 ///   Joints between two fixed bodies are left out: nothing can move them.
-/// - After the island starts, the gap each island joint had in the scene
-///   as given (m, f32 bits, in the islands' order): `solve_joints` closes
-///   what a scene starts with at a bounded speed.
 pub struct JointLists {
     pub starts: Vec<u32>,
     pub refs: Vec<JointRef>,
@@ -207,22 +204,7 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
         islands += 1;
     }
     island_starts.push(refs.len() as u32);
-    let first_island_ref = island_starts[0] as usize;
     starts.extend(island_starts);
-    // the scene's own gaps, from its poses as given
-    let anchor = |body: u32, local: [f32; 3]| {
-        if body == WORLD {
-            return DVec3::from_array(local.map(f64::from));
-        }
-        let b = &scene.bodies[body as usize];
-        let o = b.orientation.map(f64::from);
-        let q = DQuat::from_xyzw(o[0], o[1], o[2], o[3]).normalize();
-        DVec3::from_array(b.position.map(f64::from)) + q * DVec3::from_array(local.map(f64::from))
-    };
-    for r in &refs[first_island_ref..] {
-        let gap = (anchor(r.partner, r.local_partner) - anchor(r.body, r.local_self)).length() as f32;
-        starts.push(gap.to_bits());
-    }
     JointLists { starts, refs, islands }
 }
 
@@ -301,8 +283,8 @@ mod tests {
     use crate::scenes::{box_body, stack};
 
     /// Islands: a chain pinned to the world at its far end (ordered outward
-    /// from the pin), a free pair (from its lowest body), a joint between
-    /// two fixed bodies (left out), and each island joint's given gap.
+    /// from the pin), a body held by a fixed one, and a joint between two
+    /// fixed bodies (left out).
     #[test]
     fn joint_lists_split_and_order_the_islands() {
         let mut scene = stack(0);
@@ -331,13 +313,6 @@ mod tests {
         // 4); a body's joints in the scene's order
         assert_eq!(island(0), vec![(2, 1), (2, WORLD), (1, 0)]);
         assert_eq!(island(1), vec![(3, 4)]);
-        // the gaps as given, after the 3 island starts: the bodies sit where
-        // their anchors meet, so every gap is 0 until a body is moved
-        let gaps: Vec<f32> = lists.starts[n + 4..].iter().map(|&g| f32::from_bits(g)).collect();
-        assert_eq!(gaps.len(), 4);
-        assert!(gaps.iter().all(|&g| g < 1e-6), "{gaps:?}");
-        scene.bodies[0].position[0] -= 0.25;
-        let gaps: Vec<f32> = joint_lists(&scene).starts[n + 4..].iter().map(|&g| f32::from_bits(g)).collect();
-        assert!((gaps[2] - 0.25).abs() < 1e-6, "{gaps:?}"); // joint (1, 0), third in island 0
+        assert_eq!(lists.starts.len(), n + 1 + 3);
     }
 }

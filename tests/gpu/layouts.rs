@@ -62,11 +62,7 @@ fn shared_structs_match_member_by_member() {
             substep,
             opaque_zero,
             island_count,
-            joint_sweeps,
-            elapsed,
-            _pad0,
-            _pad1,
-            _pad2
+            joint_sweeps
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, body });

@@ -236,8 +236,9 @@ fn fastest_over(scene: &Scene, steps: u32) -> Option<(f32, f32)> {
 }
 
 /// Issue 16: joint error a scene starts with is closed at a bounded speed,
-/// as overlap is (3 m/s a joint), not snapped shut in one substep. No
-/// gravity: only the joints move anything.
+/// as overlap is (3 m/s a joint), not snapped shut in one substep, and
+/// joints that cannot all close do not throw or spin bodies. No gravity:
+/// only the joints move anything.
 #[test]
 fn joints_a_scene_leaves_open_close_at_a_bounded_speed() {
     // four boxes 1.5 m apart in a square, joined in a ring whose joints
@@ -265,4 +266,19 @@ fn joints_a_scene_leaves_open_close_at_a_bounded_speed() {
     let Some((fastest, _)) = fastest_over(&taut, 120) else { return };
     eprintln!("chain pinned beyond its reach: fastest body {fastest} m/s");
     assert!(fastest < 3.0, "the unreachable pins threw the chain at {fastest} m/s");
+
+    // a loop of the wrong lengths: three 0.5 m boxes whose joints ask for a
+    // triangle of sides 0.5, 0.5 and 3 m (it spun a body past the fault
+    // limit when the joints' old gaps closed whole); fastest_over refuses
+    // a fault
+    let mut wrong = ring.clone();
+    wrong.bodies = (0..3).map(|k| box_body([0.25; 3], [0.5 * k as f32, 3.0, 0.0])).collect();
+    wrong.joints = vec![
+        Joint { bodies: [0, 1], anchors: [[0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]] },
+        Joint { bodies: [1, 2], anchors: [[0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]] },
+        Joint { bodies: [2, 0], anchors: [[0.25, 0.0, 0.0], [-3.0, 0.0, 0.0]] },
+    ];
+    let Some((fastest, _)) = fastest_over(&wrong, 300) else { return };
+    eprintln!("a loop of the wrong lengths: fastest body {fastest} m/s");
+    assert!(fastest < 4.0, "the loop threw a body at {fastest} m/s");
 }
