@@ -211,7 +211,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
 // on a pile 7 cm. In turn, a sweep outward from where the island is held
 // and back carries it along the whole island. Each joint's snap closes its
 // whole gap (eq. 9 with nothing to overshoot: no other snap is summed with
-// it), shared by the two bodies' generalised inverse masses along the gap,
+// it; only an old gap's closing speed is bounded, see close_joint), shared
+// by the two bodies' generalised inverse masses along the gap,
 // and moves the displacement with the pose, as solve's snaps do. A pass
 // makes params.joint_sweeps such sweeps (see JOINT_SWEEPS_PER_SUBSTEP in
 // src/world.rs).
