@@ -150,7 +150,8 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
     let held = |b: usize| touching[b].iter().any(|&k| scene.joints[k].bodies.iter().any(|&o| !movable(o)));
     let mut seeds: Vec<usize> = (0..n).filter(|&b| !touching[b].is_empty() && held(b)).collect();
     seeds.extend((0..n).filter(|&b| !touching[b].is_empty() && !held(b)));
-    let mut island_of = vec![u32::MAX; n];
+    // bodies already given to an island
+    let mut placed = vec![false; n];
     let mut joint_done = vec![false; scene.joints.len()];
     let mut islands = 0u32;
     let mut queue = std::collections::VecDeque::new();
@@ -158,19 +159,19 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
     // reached by an island's walk (each body belongs to one island)
     let mut reached = vec![false; n];
     for seed in seeds {
-        if island_of[seed] != u32::MAX {
+        if placed[seed] {
             continue;
         }
         // this seed's island: every root in it starts the breadth-first walk
         island_starts.push(refs.len() as u32);
         let mut members = vec![seed];
-        island_of[seed] = islands;
+        placed[seed] = true;
         let mut at = 0;
         while at < members.len() {
             for &k in &touching[members[at]] {
                 for b in scene.joints[k].bodies {
-                    if movable(b) && island_of[b as usize] == u32::MAX {
-                        island_of[b as usize] = islands;
+                    if movable(b) && !placed[b as usize] {
+                        placed[b as usize] = true;
                         members.push(b as usize);
                     }
                 }
