@@ -7,6 +7,9 @@
 
 // An edge axis must beat the best face axis by this much (m) to be chosen.
 const EDGE_BIAS: f32 = 0.005;
+// The second box's face must beat the first's by this much (m) to be the
+// reference face (see the reference's FACE_BIAS).
+const FACE_BIAS: f32 = 0.0025;
 
 struct Shape {
     centre: vec3<f32>,
@@ -134,15 +137,16 @@ fn closest_on_edges(pa: vec3<f32>, da: vec3<f32>, la: f32, pb: vec3<f32>, db: ve
     *out_b = pb + db * t;
 }
 
-// The clipped polygon, in two buffers that the four clips write in turn
-// (the next clip reads what the last wrote; no copying between them).
-var<private> poly_a: array<vec3<f32>, 8>;
-var<private> poly_b: array<vec3<f32>, 8>;
+// The clipped polygon, in the reference face's plane (coordinates along its
+// two side axes), in two buffers that the four clips write in turn (the next
+// clip reads what the last wrote; no copying between them).
+var<private> poly_a: array<vec2<f32>, 8>;
+var<private> poly_b: array<vec2<f32>, 8>;
 
 // Sutherland-Hodgman: the part of polygon `src` (len points) with
 // dot(p, n) <= offset, into `dst`; returns its length.
-fn clip_poly(src: ptr<private, array<vec3<f32>, 8>>, len: u32, dst: ptr<private, array<vec3<f32>, 8>>,
-             n: vec3<f32>, offset: f32) -> u32 {
+fn clip_poly(src: ptr<private, array<vec2<f32>, 8>>, len: u32, dst: ptr<private, array<vec2<f32>, 8>>,
+             n: vec2<f32>, offset: f32) -> u32 {
     var out_len = 0u;
     for (var i = 0u; i < len; i = i + 1u) {
         let p = (*src)[i];
@@ -166,9 +170,14 @@ fn column(m: mat3x3<f32>, k: u32) -> vec3<f32> {
     return select(select(m[2], m[1], k == 1u), m[0], k == 0u);
 }
 
+// z x of two vectors in a plane (twice the signed area of their triangle).
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
 // The separating-axis test of two boxes within `margin`: the axis of
-// least separation, a face axis (a's faces 0..3, b's 3..6) unless an edge
-// axis beats it by EDGE_BIAS. Its normal points from a to b.
+// least separation, a face axis (a's faces 0..3, b's 3..6; b's only if it
+// beats a's by FACE_BIAS) unless an edge axis beats it by EDGE_BIAS. Its normal points from a to b.
 struct BoxAxis {
     kind: u32, // AXIS_*
     normal: vec3<f32>,
@@ -197,14 +206,15 @@ fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let sep_a = abs(t) - ha - ar * hb;
     let s_b = t * r;
     let sep_b = abs(s_b) - ha * ar - hb;
-    var worst = max(max(max(sep_a.x, sep_a.y), max(sep_a.z, sep_b.x)), max(sep_b.y, sep_b.z));
-    var best_face_sep = sep_a.x;
-    var best_face = 0u;
-    for (var k = 1u; k < 6u; k = k + 1u) {
-        let sep = select(sep_b[k - 3u], sep_a[min(k, 2u)], k < 3u);
-        best_face = select(best_face, k, sep > best_face_sep);
-        best_face_sep = max(best_face_sep, sep);
-    }
+    // the best face of each (the first of equals); b's is the reference
+    // face only if it beats a's by FACE_BIAS
+    let a_sep = max(max(sep_a.x, sep_a.y), sep_a.z);
+    let b_sep = max(max(sep_b.x, sep_b.y), sep_b.z);
+    let a_face = select(select(2u, 1u, sep_a.y >= sep_a.z), 0u, sep_a.x >= sep_a.y && sep_a.x >= sep_a.z);
+    let b_face = select(select(2u, 1u, sep_b.y >= sep_b.z), 0u, sep_b.x >= sep_b.y && sep_b.x >= sep_b.z);
+    let best_face = select(a_face, 3u + b_face, b_sep > a_sep + FACE_BIAS);
+    let best_face_sep = max(a_sep, b_sep);
+    var worst = best_face_sep;
     let face_s = select(s_b[best_face % 3u], t[best_face % 3u], best_face < 3u);
     let face_axis = select(axes_b[best_face % 3u], axes_a[best_face % 3u], best_face < 3u);
     let best_face_n = select(face_axis, -face_axis, face_s < 0.0);
@@ -270,9 +280,8 @@ fn box_box_edge(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
 // The manifold of a face contact (an AXIS_FACE of normal n, reference face
 // best_face): the incident face of the other box clipped against the
 // reference face's sides, its points within the margin, reduced to four.
-// Only the clipped polygon is an array; a kept point's two ends are
-// recomputed from it where needed (face_point), and the reduction keeps
-// indices into it.
+// The clipping runs in the reference face's plane; a point's height above
+// that face follows from the incident face's plane.
 fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>,
                 n: vec3<f32>, best_face: u32, margin: f32) -> Manifold {
     var m = empty_manifold();
@@ -290,93 +299,98 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let inc_axes = mat3x3<f32>(select(axes_b[0], axes_a[0], flipped), select(axes_b[1], axes_a[1], flipped),
                                select(axes_b[2], axes_a[2], flipped));
     let ref_n = select(n, -n, flipped);
-    // incident face: the face of the incident box most anti-parallel to
-    // ref_n (the first of equals)
-    let along = vec3<f32>(abs(dot(inc_axes[0], ref_n)), abs(dot(inc_axes[1], ref_n)), abs(dot(inc_axes[2], ref_n)));
+    // incident face: the face of the incident box most anti-parallel to ref_n
+    // (the first of equals)
+    let along = abs(ref_n * inc_axes);
     let inc_face = select(select(2u, 1u, along.y >= along.z), 0u, along.x >= along.y && along.x >= along.z);
     let inc_axis = column(inc_axes, inc_face);
-    let inc_sign = -sign_of(dot(inc_axis, ref_n));
-    let inc_centre = inc_c + inc_axis * (inc_h[inc_face] * inc_sign);
-    let u = (inc_face + 1u) % 3u;
-    let v = (inc_face + 2u) % 3u;
-    let eu = column(inc_axes, u) * inc_h[u];
-    let ev = column(inc_axes, v) * inc_h[v];
-    poly_a[0] = inc_centre + eu + ev;
-    poly_a[1] = inc_centre - eu + ev;
-    poly_a[2] = inc_centre - eu - ev;
-    poly_a[3] = inc_centre + eu - ev;
+    let inc_centre = inc_c + inc_axis * (inc_h[inc_face] * -sign_of(dot(inc_axis, ref_n)));
+    let eu = column(inc_axes, (inc_face + 1u) % 3u) * inc_h[(inc_face + 1u) % 3u];
+    let ev = column(inc_axes, (inc_face + 2u) % 3u) * inc_h[(inc_face + 2u) % 3u];
 
-    // clip against the four side planes of the reference face: the two
-    // faces along its first side axis, then along its second
+    // the reference face's frame: its centre, its two side axes and ref_n
     let ref_centre = ref_c + ref_n * ref_h[face];
     let side_u = (face + 1u) % 3u;
     let side_v = (face + 2u) % 3u;
-    let u_n = column(ref_axes, side_u);
-    let v_n = column(ref_axes, side_v);
-    var len = clip_poly(&poly_a, 4u, &poly_b, u_n, dot(u_n, ref_c) + ref_h[side_u]);
-    len = clip_poly(&poly_b, len, &poly_a, -u_n, dot(-u_n, ref_c) + ref_h[side_u]);
-    len = clip_poly(&poly_a, len, &poly_b, v_n, dot(v_n, ref_c) + ref_h[side_v]);
-    len = clip_poly(&poly_b, len, &poly_a, -v_n, dot(-v_n, ref_c) + ref_h[side_v]);
+    let su = column(ref_axes, side_u);
+    let sv = column(ref_axes, side_v);
+    let to_face = transpose(mat3x3<f32>(su, sv, ref_n));
+    let c = to_face * (inc_centre - ref_centre);
+    let du = (to_face * eu).xy;
+    let dv = (to_face * ev).xy;
+    poly_a[0] = c.xy + du + dv;
+    poly_a[1] = c.xy - du + dv;
+    poly_a[2] = c.xy - du - dv;
+    poly_a[3] = c.xy + du - dv;
+    // height of the incident face above the reference face at p:
+    // c.z + dot(slope, p - c.xy) (|nf.z| >= 1/sqrt(3): the most parallel axis)
+    let nf = to_face * inc_axis;
+    let slope = -nf.xy / nf.z;
+
+    // clip against the four side planes of the reference face: the two
+    // faces along its first side axis, then along its second
+    let half = vec2<f32>(ref_h[side_u], ref_h[side_v]);
+    var len = clip_poly(&poly_a, 4u, &poly_b, vec2<f32>(1.0, 0.0), half.x);
+    len = clip_poly(&poly_b, len, &poly_a, vec2<f32>(-1.0, 0.0), half.x);
+    len = clip_poly(&poly_a, len, &poly_b, vec2<f32>(0.0, 1.0), half.y);
+    len = clip_poly(&poly_b, len, &poly_a, vec2<f32>(0.0, -1.0), half.y);
 
     // the points within the margin of the reference face (`kept`), reduced
     // to four: the deepest, the farthest from it, the largest triangle, the
     // largest area added outside that triangle (the first of equals each)
     var count = 0u;
-    var c0 = 0u;
+    var c0 = 8u;
     var deepest = 3.4e38;
     for (var k = 0u; k < len; k = k + 1u) {
-        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
-        let sep = dot(f.on_b - f.on_a, n);
-        if (f.kept && sep < deepest) {
-            deepest = sep;
-            c0 = k;
+        let z = c.z + dot(slope, poly_a[k] - c.xy);
+        if (z <= margin) {
+            count = count + 1u;
+            if (z < deepest) {
+                deepest = z;
+                c0 = k;
+            }
         }
-        count = count + u32(f.kept);
     }
     m.normal = n;
     if (count <= MAX_POINTS) {
         for (var k = 0u; k < len; k = k + 1u) {
-            let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
-            if (f.kept) {
-                m.on_a[m.count] = f.on_a;
-                m.on_b[m.count] = f.on_b;
-                m.count = m.count + 1u;
+            let z = c.z + dot(slope, poly_a[k] - c.xy);
+            if (z <= margin) {
+                face_point(&m, poly_a[k], z, ref_centre, su, sv, ref_n, flipped);
             }
         }
         return m;
     }
-    let p0 = face_point(poly_a[c0], ref_centre, ref_n, flipped, margin).on_b;
+    let p0 = poly_a[c0];
     var c1 = c0;
     var best = -1.0;
     for (var k = 0u; k < len; k = k + 1u) {
-        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
-        let dd = dot(f.on_b - p0, f.on_b - p0);
-        if (f.kept && dd > best) {
+        let q = poly_a[k];
+        let dd = dot(q - p0, q - p0);
+        if (c.z + dot(slope, q - c.xy) <= margin && dd > best) {
             best = dd;
             c1 = k;
         }
     }
-    let p1 = face_point(poly_a[c1], ref_centre, ref_n, flipped, margin).on_b;
+    let p1 = poly_a[c1];
     var c2 = c0;
     best = -3.4e38;
     for (var k = 0u; k < len; k = k + 1u) {
-        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
-        let area = abs(dot(cross(p1 - p0, f.on_b - p0), n));
-        if (f.kept && area > best) {
+        let q = poly_a[k];
+        let area = abs(cross2(p1 - p0, q - p0));
+        if (c.z + dot(slope, q - c.xy) <= margin && area > best) {
             best = area;
             c2 = k;
         }
     }
-    let p2 = face_point(poly_a[c2], ref_centre, ref_n, flipped, margin).on_b;
-    let side = sign_of(dot(cross(p1 - p0, p2 - p0), n));
+    let p2 = poly_a[c2];
+    let side = sign_of(cross2(p1 - p0, p2 - p0));
     var c3 = c0;
     best = -3.4e38;
     for (var k = 0u; k < len; k = k + 1u) {
-        let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
-        let q = f.on_b;
-        let added = max(max(-side * dot(cross(p1 - p0, q - p0), n), -side * dot(cross(p2 - p1, q - p1), n)),
-                        -side * dot(cross(p0 - p2, q - p2), n));
-        if (f.kept && added > best) {
+        let q = poly_a[k];
+        let added = max(max(-side * cross2(p1 - p0, q - p0), -side * cross2(p2 - p1, q - p1)), -side * cross2(p0 - p2, q - p2));
+        if (c.z + dot(slope, q - c.xy) <= margin && added > best) {
             best = added;
             c3 = k;
         }
@@ -386,28 +400,22 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
         let k = select(select(select(c3, c2, e == 2u), c1, e == 1u), c0, e == 0u);
         let seen = (e > 0u && k == c0) || (e > 1u && k == c1) || (e > 2u && k == c2);
         if (!seen) {
-            let f = face_point(poly_a[k], ref_centre, ref_n, flipped, margin);
-            m.on_a[m.count] = f.on_a;
-            m.on_b[m.count] = f.on_b;
-            m.count = m.count + 1u;
+            let q = poly_a[k];
+            face_point(&m, q, c.z + dot(slope, q - c.xy), ref_centre, su, sv, ref_n, flipped);
         }
     }
     return m;
 }
 
-// A clipped point p of the incident face as a contact point: its two ends
-// (p and its projection on the reference face, in the order of the pair),
-// and whether it lies within the margin of the face.
-struct FacePoint {
-    on_a: vec3<f32>,
-    on_b: vec3<f32>,
-    kept: bool,
-}
-
-fn face_point(p: vec3<f32>, ref_centre: vec3<f32>, ref_n: vec3<f32>, flipped: bool, margin: f32) -> FacePoint {
-    let sep = dot(p - ref_centre, ref_n);
-    let on_ref = p - ref_n * sep;
-    return FacePoint(select(on_ref, p, flipped), select(p, on_ref, flipped), sep <= margin);
+// Appends to m the face contact point at p in the reference face's plane,
+// z above it: the incident box's point and its projection on the face.
+fn face_point(m: ptr<function, Manifold>, p: vec2<f32>, z: f32, ref_centre: vec3<f32>, su: vec3<f32>,
+              sv: vec3<f32>, ref_n: vec3<f32>, flipped: bool) {
+    let on_ref = ref_centre + su * p.x + sv * p.y;
+    let on_inc = on_ref + ref_n * z;
+    (*m).on_a[(*m).count] = select(on_ref, on_inc, flipped);
+    (*m).on_b[(*m).count] = select(on_inc, on_ref, flipped);
+    (*m).count = (*m).count + 1u;
 }
 
 // The manifold of a pair of which at least one is a sphere.

@@ -5,7 +5,7 @@
 
 use crate::common::Rng;
 use glam::{Quat, Vec3};
-use verlet::reference::collide::{box_box, Manifold, EDGE_BIAS};
+use verlet::reference::collide::{box_box, Manifold, EDGE_BIAS, FACE_BIAS};
 
 #[derive(Clone, Copy)]
 struct Obb {
@@ -88,7 +88,8 @@ fn check(a: &Obb, b: &Obb, margin: f32, m: Option<Manifold>, stats: &mut [usize;
     assert!(m.normal.dot(b.c - a.c) >= -tol, "normal points from b to a");
     for p in &m.points {
         let depth = -p.separation(m.normal);
-        // faces are preferred to edges by EDGE_BIAS, which bounds the excess
+        // faces are preferred to edges by EDGE_BIAS (and the first box's
+        // faces to the second's by the smaller FACE_BIAS), which bounds the excess
         assert!(
             depth <= overlap.max(0.0) + EDGE_BIAS + tol,
             "depth {depth} > true overlap {overlap}; {} points, n {:?}, a {:?} {:?} {:?} b {:?} {:?} {:?}",
@@ -153,4 +154,26 @@ fn box_resting_flat_on_box_gives_four_points() {
     for p in &m.points {
         assert!((p.separation(m.normal) + 0.01).abs() < 1e-5);
     }
+}
+
+/// Nearly parallel faces: the second box's face becomes the reference face
+/// only when it beats the first's by FACE_BIAS, so a box lying tilted on
+/// another does not switch between two different manifolds from step to step.
+#[test]
+fn the_first_boxs_face_is_kept_unless_the_seconds_beats_it_by_face_bias() {
+    let cube = Vec3::splat(0.5);
+    let slab = Vec3::new(2.0, 0.5, 2.0);
+    // the cube (first), turned by `tilt` about z, 1 mm into the slab below it
+    // (second): the slab's face separates them less than the cube's by
+    // about (2 - 0.5) tilt
+    let normal_for = |tilt: f32| {
+        let q = Quat::from_rotation_z(tilt);
+        let c = Vec3::new(0.0, 0.5 + 0.5 * (tilt.cos() + tilt.sin()) - 0.001, 0.0);
+        (box_box(c, q, cube, Vec3::ZERO, Quat::IDENTITY, slab, 0.02).unwrap().normal, q)
+    };
+    assert!(1.5 * 0.001 < FACE_BIAS && FACE_BIAS < 1.5 * 0.003);
+    let (n, q) = normal_for(0.001);
+    assert!((n + q * Vec3::Y).length() < 1e-5, "1.5 mm better: the cube's face is kept, got normal {n:?}");
+    let (n, _) = normal_for(0.003);
+    assert!((n + Vec3::Y).length() < 1e-5, "4.5 mm better: the slab's face, got normal {n:?}");
 }
