@@ -298,6 +298,10 @@ pub fn gpu_bytes(scene: &Scene) -> u64 {
         + size((n + 1) * std::mem::size_of::<PairMeta>() as u64)
         + size(2 * pairs * 4)
         + 64
+        // where a batch starts from: the state, the pair bookkeeping, the status
+        + size(n * state)
+        + size((n + 1) * std::mem::size_of::<PairMeta>() as u64)
+        + 64
         + 32
         + PARAMS_STRIDE * 64
         + joints

@@ -65,6 +65,11 @@ struct WorldData {
     /// Working buffers of the passes: vel0, and the grid's cell_count,
     /// cell_start, block_sums and sorted.
     scratch: [wgpu::Buffer; 5],
+    /// What a batch of steps starts from (the state, `pair_meta`, whose wake
+    /// flags carry over, and `status`), copied as each batch begins, so that
+    /// a batch during which a pool overflowed is taken again from the same
+    /// start once the pools have grown (`World::step_with`).
+    batch_start: [wgpu::Buffer; 3],
 }
 
 impl WorldData {
@@ -231,14 +236,32 @@ pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
 
 /// Bytes of GPU memory per body: poses (two buffers), properties, velocities,
 /// the pair list (pairs, the bodies' lists of them, their bookkeeping), the
-/// manifold pool with its snaps, and the grid's share (sorted list, about two hash buckets
-/// with their counts and starts).
+/// manifold pool with its snaps, the grid's share (sorted list, about two
+/// hash buckets with their counts and starts), and the copy of the pose and
+/// the pair bookkeeping a batch of steps starts from.
 pub fn bytes_per_body() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
-    let pairs = PAIRS_PER_BODY * (std::mem::size_of::<Pair>() as u64 + 2 * 4) + std::mem::size_of::<PairMeta>() as u64;
+    let meta = std::mem::size_of::<PairMeta>() as u64;
+    let pairs = PAIRS_PER_BODY * (std::mem::size_of::<Pair>() as u64 + 2 * 4) + meta;
     let manifolds = MANIFOLDS_PER_BODY * (std::mem::size_of::<ContactManifold>() + std::mem::size_of::<ManifoldSnaps>()) as u64;
     let grid = 4 + 2 * 8;
-    2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + pairs + manifolds + grid
+    let batch_start = state + meta;
+    2 * state
+        + std::mem::size_of::<BodyProps>() as u64
+        + std::mem::size_of::<Velocity>() as u64
+        + pairs
+        + manifolds
+        + grid
+        + batch_start
+}
+
+/// The host's side of where a batch of steps started (`World::batch_start`).
+#[derive(Clone, Copy)]
+struct BatchStart {
+    current: usize,
+    step: u64,
+    time: f64,
+    dt_prev: f32,
 }
 
 pub struct World {
@@ -316,7 +339,9 @@ impl World {
         let pairs = storage("pairs", pair_capacity * std::mem::size_of::<Pair>() as u64);
         let manifolds = storage("manifolds", manifold_capacity * std::mem::size_of::<ContactManifold>() as u64);
         let snaps = storage("manifolds/snaps", manifold_capacity * std::mem::size_of::<ManifoldSnaps>() as u64);
-        let pair_meta = storage("pairs/meta", (count as u64 + 1) * std::mem::size_of::<PairMeta>() as u64);
+        let meta_bytes = (count as u64 + 1) * std::mem::size_of::<PairMeta>() as u64;
+        let pair_meta = storage("pairs/meta", meta_bytes);
+        let state_bytes = (count * std::mem::size_of::<BodyState>()) as u64;
         let body_pairs = storage("pairs/body_lists", 2 * pair_capacity * 4);
         let status = with_data("status", bytemuck::cast_slice(&STATUS_INIT));
         let dispatch = device.create_buffer(&wgpu::BufferDescriptor {
@@ -349,6 +374,11 @@ impl World {
             props: props_buf,
             statics: [large_buf, joint_start, joint_refs],
             scratch: [vel0, cell_count, cell_start, block_sums, sorted],
+            batch_start: [
+                storage("batch start/state", state_bytes),
+                storage("batch start/pairs meta", meta_bytes),
+                storage("batch start/status", STATUS_BYTES),
+            ],
         };
         data.bind_groups = Some(data.step_bind_groups(device, &pipelines.layout));
         if !large.is_empty() {
@@ -434,19 +464,46 @@ impl World {
         let substeps = self.settings.substeps as usize;
         let per_batch = (MAX_BATCH / substeps).max(1);
         for chunk in dts.chunks(per_batch) {
+            let start = self.batch_start();
             self.encode_and_submit(chunk, substeps);
-            self.fit_pools()?;
+            while self.fit_pools()? {
+                self.restore_batch_start(start);
+                self.encode_and_submit(chunk, substeps);
+            }
         }
         Ok(())
+    }
+
+    /// Where the next batch starts from, on the host's side: which state
+    /// buffer is current, the step count, the time and the last substep's
+    /// length (the GPU's side is copied by `encode_and_submit`).
+    fn batch_start(&self) -> BatchStart {
+        BatchStart { current: self.current, step: self.step, time: self.time, dt_prev: self.dt_prev }
+    }
+
+    /// Puts the world back where a batch started (`batch_start` and the
+    /// copies `encode_and_submit` made), to take the batch again.
+    fn restore_batch_start(&mut self, start: BatchStart) {
+        let BatchStart { current, step, time, dt_prev } = start;
+        (self.current, self.step, self.time, self.dt_prev) = (current, step, time, dt_prev);
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("redo batch") });
+        let [state, meta, status] = &self.data.batch_start;
+        encoder.copy_buffer_to_buffer(state, 0, &self.data.states[current], 0, state.size());
+        encoder.copy_buffer_to_buffer(meta, 0, &self.data.pair_meta, 0, meta.size());
+        encoder.copy_buffer_to_buffer(status, 0, &self.data.status, 0, STATUS_BYTES);
+        self.gpu.queue.submit([encoder.finish()]);
     }
 
     /// Grows the pair list and the manifold pool, before the next step,
     /// once a step has used more than half of either (a 64-byte blocking
     /// readback of the status words after every batch of steps). Both are
-    /// rebuilt every step, so nothing is carried over; a pool already at its
-    /// binding's limit stays, and an overflow is reported by
+    /// rebuilt every step, so nothing is carried over. Returns whether a
+    /// step of the last batch wanted more than a pool held and the pool has
+    /// grown: which pairs or manifolds then found no room depended on thread
+    /// timing, so the caller takes the batch again. A pool already at its
+    /// binding's limit stays, and its overflow is reported by
     /// `contact_report`.
-    fn fit_pools(&mut self) -> Result<(), Error> {
+    fn fit_pools(&mut self) -> Result<bool, Error> {
         let report = self.contact_report()?;
         let (most_pairs, most_manifolds) = pair_capacities(&self.gpu, u64::MAX);
         let want = |used: u32, capacity: u32, most: u64| {
@@ -456,7 +513,7 @@ impl World {
         let pairs = want(report.pairs_max, report.pair_capacity, most_pairs);
         let manifolds = want(report.manifolds_max, report.manifold_capacity, most_manifolds);
         if pairs.is_none() && manifolds.is_none() {
-            return Ok(());
+            return Ok(false);
         }
         let device = &self.gpu.device;
         let storage = |label: &str, size: u64| {
@@ -486,7 +543,10 @@ impl World {
         self.gpu.queue.submit([encoder.finish()]);
         self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines.layout));
         self.gpu.check()?;
-        Ok(())
+        let grown_past = |wanted: u32, grown: Option<u64>| grown.is_some_and(|n| wanted as u64 <= n);
+        Ok(report.overflowed()
+            && (report.pairs_max <= report.pair_capacity || grown_past(report.pairs_max, pairs))
+            && (report.manifolds_max <= report.manifold_capacity || grown_past(report.manifolds_max, manifolds)))
     }
 
     /// Writes one Params slot per substep of `dts`.
@@ -542,10 +602,20 @@ impl World {
         self.time += dts.iter().map(|&d| d as f64).sum::<f64>();
     }
 
+    /// Records copies of what a batch starts from on the GPU (see
+    /// `WorldData::batch_start`).
+    fn copy_batch_start(&self, encoder: &mut wgpu::CommandEncoder) {
+        let [state, meta, status] = &self.data.batch_start;
+        encoder.copy_buffer_to_buffer(&self.data.states[self.current], 0, state, 0, state.size());
+        encoder.copy_buffer_to_buffer(&self.data.pair_meta, 0, meta, 0, meta.size());
+        encoder.copy_buffer_to_buffer(&self.data.status, 0, status, 0, STATUS_BYTES);
+    }
+
     fn encode_and_submit(&mut self, dts: &[f32], substeps: usize) {
         let slot = self.write_params(dts, substeps);
 
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("step") });
+        self.copy_batch_start(&mut encoder);
         let plan = self.step_plan();
         for first in (0..slot).step_by(substeps) {
             for &(stage, sub) in &plan {
@@ -665,11 +735,15 @@ impl World {
         let gpu = self.gpu.clone();
         let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let timer = timestamps.then(|| crate::gpu::PassTimer::new(&gpu, "profile", passes));
-        for _ in 0..steps {
+        let mut step = 0;
+        while step < steps {
+            let start = self.batch_start();
+            let before = totals.clone();
             let dt = [self.settings.dt];
             self.write_params(&dt, substeps);
             let mut k = 0;
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.copy_batch_start(&mut encoder);
             {
                 for &(stage, slot) in &plan {
                     match &timer {
@@ -699,7 +773,14 @@ impl World {
                 }
             }
             self.finish_steps(&dt, substeps);
-            self.fit_pools()?;
+            if self.fit_pools()? {
+                // a pool overflowed: the step is taken again (as step_with
+                // does), its first timing dropped
+                self.restore_batch_start(start);
+                totals = before;
+                continue;
+            }
+            step += 1;
         }
         let n = steps.max(1) as f64;
         Ok(StageTimes {
