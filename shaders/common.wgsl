@@ -133,13 +133,20 @@ struct ContactManifold {
 // points (solve_contacts, restitution_contacts): a move (m, or m/s in
 // restitution) and a turn (radians, or rad/s), world axes; `count`: 1 if
 // the manifold snapped the body (solve) or the points that acted
-// (restitution); `pressed`: 1 if a point has pushed in this substep. 32 bytes.
+// (restitution); `flags`: SNAP_PRESSED if a point has pushed in this
+// substep, and above SETTLE_SHIFT the share of the move and turn that
+// pushes out old overlap MAX_DEPENETRATION_SPEED held back, in
+// 1/SETTLE_ONE (solve only; see solve.wgsl). 32 bytes.
 struct EndSnap {
     dx: vec3<f32>,
     count: u32,
     dtheta: vec3<f32>,
-    pressed: u32,
+    flags: u32,
 }
+
+const SNAP_PRESSED: u32 = 1u;
+const SETTLE_SHIFT: u32 = 16u;
+const SETTLE_ONE: f32 = 65535.0;
 
 // Both ends' snaps of one manifold, at its index in the pool. 64 bytes.
 struct ManifoldSnaps {
@@ -313,11 +320,11 @@ fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
 // What a summed impulse-like vector j (through points at summed moments
 // `moment` = sum of r x j) asks of an end: its inverse mass times j, its
 // world inverse inertia times the moment (nothing for an end that stays).
-fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, pressed: u32) -> EndSnap {
+fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, flags: u32) -> EndSnap {
     if (!e.moves) {
-        return EndSnap(vec3<f32>(0.0), 0u, vec3<f32>(0.0), pressed);
+        return EndSnap(vec3<f32>(0.0), 0u, vec3<f32>(0.0), flags);
     }
-    return EndSnap(j * e.inv_inertia.w, count, inv_inertia_world(e.rot, e.inv_inertia.xyz, moment), pressed);
+    return EndSnap(j * e.inv_inertia.w, count, inv_inertia_world(e.rot, e.inv_inertia.xyz, moment), flags);
 }
 
 // Restitution and friction of a contact: the larger restitution and the

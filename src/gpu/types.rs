@@ -157,7 +157,7 @@ pub struct EndSnap {
     pub dx: [f32; 3],
     pub count: u32,
     pub dtheta: [f32; 3],
-    pub pressed: u32,
+    pub flags: u32,
 }
 
 /// Both ends' snaps of one manifold (64 bytes).

@@ -230,7 +230,7 @@ impl Stage {
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Integrate => &[Params, Props, StateIn, Status, JointStart, PairMeta],
             Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status],
-            Stage::Solve => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs],
+            Stage::Solve => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs, JointStart],
             Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
             Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status],
             Stage::Restitution => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs],

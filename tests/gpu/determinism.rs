@@ -23,11 +23,14 @@ const STEPS: u64 = 300;
 /// test in the first box's frame (the same axes and choices, other roundings).
 /// Re-pinned for the clip in the reference face's plane (the same points,
 /// other roundings) and FACE_BIAS (the second box's face is the reference
-/// face only when it beats the first's by 2.5 mm).
+/// face only when it beats the first's by 2.5 mm). Re-pinned for settling
+/// (solve.wgsl: old overlap deeper than 1 m/s of a substep is pushed out by
+/// moving the poses, not the velocities; the cubes land hard enough to
+/// leave such overlap).
 /// Any change to the step's arithmetic (shaders, settings
 /// defaults, the cubes scene) moves it on purpose: check the change, then
 /// pin the value the failure prints.
-const PINNED_LAVAPIPE: u64 = 0x99be_6a56_552b_33c6;
+const PINNED_LAVAPIPE: u64 = 0x80b7_4619_663c_0cad;
 /// The adapter name and driver the hash was pinned on.
 const PINNED_ON: (&str, &str) = ("llvmpipe (LLVM 15.0.6, 256 bits)", "Mesa 22.3.6 (LLVM 15.0.6)");
 
