@@ -1,14 +1,15 @@
 // Pass "narrowphase", once per step after the pair list (pairs.wgsl): one
 // invocation per candidate pair, dispatched indirectly over the pairs the
-// list holds, computes the pair's manifold once (collide.wgsl; against the
-// ground, up to four of a box's deepest corners or a sphere's lowest point)
-// and, if it has points, stores it in the manifold pool in the two bodies'
-// frames and lists it in both bodies' contact lists. Two boxes get only
-// their separating-axis test here; a face contact is stored pending and
-// clipped by narrowphase_clip, over the top run of the pool. Contacts are
-// generated up to a speculative gap (the distance the pair can close in one
-// step), so fast bodies meet walls instead of passing them. An awake
-// partner that moves fast or lies deep inside a sleeping body wakes it
+// list holds, computes the pair's manifold once (collide.wgsl; the ground
+// pairs in a pass of their own, narrowphase_ground: up to four of a box's
+// deepest corners or a sphere's lowest point) and, if it has points,
+// stores it in the manifold pool in the two bodies' frames and lists it in
+// both bodies' contact lists. Two boxes get only their separating-axis test
+// here; a face contact is stored pending and clipped by narrowphase_clip,
+// over the top run of the pool. Contacts are generated up to a speculative
+// gap (the distance the pair can close in one step), so fast bodies meet
+// walls instead of passing them. An awake partner that moves fast or lies
+// deep inside a sleeping body wakes it
 // (WOKEN_NOW; see pairs.wgsl and integrate.wgsl).
 
 fn shape_of(i: u32) -> Shape {
@@ -159,15 +160,8 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pr = pairs[p];
     var slot = NONE;
-    if (pr.b == GROUND) {
-        let m = ground_manifold(pr.a, CONTACT_MARGIN + pair_meta[pr.a].reach);
-        if (m.count > 0u) {
-            slot = new_manifold(pr.a, pr.b, false);
-            if (slot != NONE) {
-                store_manifold(slot, pr.a, pr.b, p, m);
-            }
-        }
-    } else {
+    // ground pairs: narrowphase_ground
+    if (pr.b != GROUND) {
         let a = shape_of(pr.a);
         let b = shape_of(pr.b);
         let margin = pair_margin(pr.a, pr.b);
@@ -197,6 +191,30 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
                     store_manifold(slot, pr.a, pr.b, p, m);
                 }
             }
+        }
+    }
+}
+
+// Pass "narrowphase_ground", after the narrowphase, one invocation per
+// body: the body's contact with the ground, if it has a ground pair (the
+// first pair it owns, see pairs.wgsl's walk). A pass of its own, so that
+// the narrowphase's vectors of packed invocations do not run the ground's
+// code beside the boxes' (lavapipe runs every branch any of them takes).
+@compute @workgroup_size(WORKGROUP)
+fn narrowphase_ground(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.body_count) {
+        return;
+    }
+    let p = pair_meta[i].owned_start;
+    if (pair_meta[i].owned == 0u || p >= min(atomicLoad(&status[0]), arrayLength(&pairs)) || pairs[p].b != GROUND) {
+        return;
+    }
+    let m = ground_manifold(i, CONTACT_MARGIN + pair_meta[i].reach);
+    if (m.count > 0u) {
+        let slot = new_manifold(i, GROUND, false);
+        if (slot != NONE) {
+            store_manifold(slot, i, GROUND, p, m);
         }
     }
 }

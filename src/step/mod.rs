@@ -39,6 +39,7 @@ pub enum Stage {
     PairsScanAdd,
     PairsWrite,
     Narrowphase,
+    NarrowphaseGround,
     ContactLists,
     NarrowphaseClip,
     Integrate,
@@ -126,7 +127,7 @@ impl Buffer {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 21] = [
+    pub const ALL: [Stage; 22] = [
         Stage::GridClear,
         Stage::GridCount,
         Stage::GridScanBlocks,
@@ -140,6 +141,7 @@ impl Stage {
         Stage::PairsScanAdd,
         Stage::PairsWrite,
         Stage::Narrowphase,
+        Stage::NarrowphaseGround,
         Stage::ContactLists,
         Stage::NarrowphaseClip,
         Stage::Integrate,
@@ -167,6 +169,7 @@ impl Stage {
             Stage::PairsScanAdd => "pairs_scan_add",
             Stage::PairsWrite => "pairs_write",
             Stage::Narrowphase => "narrowphase",
+            Stage::NarrowphaseGround => "narrowphase_ground",
             Stage::ContactLists => "contact_lists",
             Stage::NarrowphaseClip => "narrowphase_clip",
             Stage::Integrate => "integrate",
@@ -194,7 +197,9 @@ impl Stage {
     pub fn pieces(self) -> &'static [&'static str] {
         match self {
             Stage::PairsCount | Stage::PairsWrite => shaders::PAIRS_PASS,
-            Stage::Narrowphase | Stage::ContactLists | Stage::NarrowphaseClip => shaders::NARROWPHASE_PASS,
+            Stage::Narrowphase | Stage::NarrowphaseGround | Stage::ContactLists | Stage::NarrowphaseClip => {
+                shaders::NARROWPHASE_PASS
+            }
             Stage::Integrate => shaders::INTEGRATE_PASS,
             Stage::SolveContacts | Stage::Solve | Stage::SolveJoints => shaders::SOLVE_PASS,
             Stage::RestitutionContacts | Stage::Restitution => shaders::RESTITUTION_PASS,
@@ -226,6 +231,7 @@ impl Stage {
             Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta],
             Stage::PairsWrite => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta, BodyPairs],
             Stage::Narrowphase => &[Params, Props, StateIn, Pairs, Status, PairMeta],
+            Stage::NarrowphaseGround => &[Params, Props, StateIn, Pairs, Status, PairMeta],
             Stage::ContactLists => &[Params, Manifolds, Status, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Integrate => &[Params, Props, StateIn, Status, JointStart, PairMeta],
@@ -249,7 +255,7 @@ impl Stage {
             Stage::GridScatter => &[CellCount, Sorted],
             Stage::GridSort => &[Sorted],
             Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
-            Stage::Narrowphase => &[Manifolds, Status, PairMeta, BodyPairs],
+            Stage::Narrowphase | Stage::NarrowphaseGround => &[Manifolds, Status, PairMeta, BodyPairs],
             Stage::ContactLists => &[Status, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Manifolds, PairMeta],
             Stage::Integrate => &[StateOut, Vel0, Status, PairMeta],
