@@ -807,6 +807,17 @@ impl World {
         self.grid
     }
 
+    /// Bytes of GPU memory the world's buffers hold now: what `with_gpu`
+    /// allocated, with the pair list and the manifold pool as they have
+    /// grown, and the input kernels' buffers once an input was given.
+    pub fn gpu_bytes(&self) -> u64 {
+        let d = &self.data;
+        let buffers = [&d.params, &d.status, &d.pairs, &d.manifolds, &d.snaps, &d.pair_meta, &d.body_pairs, &d.dispatch, &d.props];
+        buffers.iter().map(|b| b.size()).sum::<u64>()
+            + d.states.iter().chain(&d.statics).chain(&d.scratch).chain(&d.batch_start).map(|b| b.size()).sum::<u64>()
+            + self.input.as_ref().map_or(0, |i| i.gpu_bytes())
+    }
+
     /// How full the pair list and the manifold pool got (a blocking readback).
     pub fn contact_report(&self) -> Result<ContactReport, Error> {
         let bytes = self.gpu.read_buffer(&self.data.status, STATUS_BYTES)?;

@@ -220,6 +220,13 @@ pub(super) struct InputGpu {
     bind_groups: [wgpu::BindGroup; 2],
 }
 
+impl InputGpu {
+    /// Bytes of its buffers.
+    pub(super) fn gpu_bytes(&self) -> u64 {
+        self.header.size() + self.ops.size()
+    }
+}
+
 fn check_finite(name: &str, values: &[f32]) -> Result<(), Error> {
     for (k, v) in values.iter().enumerate() {
         if !v.is_finite() {

@@ -40,6 +40,7 @@ fn the_pair_pools_grow_for_a_crowded_scene() {
     let n = scene.bodies.len();
     let Some(mut w) = crate::common::world(&scene) else { return };
     let before = w.contact_report().unwrap();
+    let bytes_before = w.gpu_bytes();
     w.step(1).unwrap();
     let first = w.contact_report().unwrap();
     w.step(1).unwrap();
@@ -53,6 +54,9 @@ fn the_pair_pools_grow_for_a_crowded_scene() {
     assert!(before.pair_capacity < lattice_pairs, "the list held every pair from the start: {before:?}");
     assert_eq!(first.pairs, lattice_pairs, "the first step's candidate pairs");
     assert!(second.pair_capacity >= lattice_pairs, "the list did not grow: {second:?}");
+    // the memory the world reports follows the pools it grew
+    let grown = |r: &verlet::world::ContactReport| r.pair_capacity as u64 * (8 + 2 * 4) + r.manifold_capacity as u64 * (160 + 64);
+    assert_eq!(w.gpu_bytes() - bytes_before, grown(&second) - grown(&before), "gpu_bytes does not follow the pools");
     // the balls push apart (at most 3 m/s) and their reach grows with their
     // speed, so later steps may want more pairs; each growth keeps up
     assert!(third.pairs <= third.pair_capacity && third.manifolds <= third.manifold_capacity, "{third:?}");
