@@ -210,9 +210,9 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the body's manifolds in pair order (contact_lists)
     for (var e = first; e < end; e = e + 1u) {
         let snap = snap_of(body_pairs[e]);
-        let share = select(snap.flags >> SETTLE_SHIFT, 0u, jointed);
-        if (share != 0u) {
-            let f = f32(share) / SETTLE_ONE;
+        let settles = select(snap.flags >> SETTLE_SHIFT, 0u, jointed);
+        if (settles != 0u) {
+            let f = f32(settles) / SETTLE_ONE;
             settle.dx = settle.dx + snap.dx * f;
             settle.dtheta = settle.dtheta + snap.dtheta * f;
             settling = settling + 1u;

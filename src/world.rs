@@ -738,14 +738,14 @@ impl World {
         let plan = self.step_plan();
         let substeps = self.settings.substeps as usize;
         let passes = plan.len();
-        let mut totals = vec![0.0f64; Stage::ALL.len()];
+        let mut totals = [0.0f64; Stage::ALL.len()];
         let gpu = self.gpu.clone();
         let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let timer = timestamps.then(|| crate::gpu::PassTimer::new(&gpu, "profile", passes));
         let mut step = 0;
         while step < steps {
             let start = self.batch_start();
-            let before = totals.clone();
+            let before = totals;
             let dt = [self.settings.dt];
             self.write_params(&dt, substeps);
             let mut k = 0;

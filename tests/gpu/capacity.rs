@@ -152,3 +152,13 @@ fn a_step_that_overflows_a_pool_is_taken_again() {
     }
     assert!(bits(&one_by_one) == bits(&batch), "steps taken one at a time differ from a batch");
 }
+
+/// A world's memory as made covers `bytes_per_body` (the figure `verlet
+/// info` and the refusal of too large a scene use), less the grid's share:
+/// the exact sizes round the hash table up.
+#[test]
+fn a_new_world_holds_at_least_the_per_body_estimate() {
+    let scene = scenes::cubes(1000, 7);
+    let Some(w) = crate::common::world(&scene) else { return };
+    assert!(w.gpu_bytes() >= (verlet::world::bytes_per_body() - 20) * 1000, "{} bytes", w.gpu_bytes());
+}
