@@ -191,6 +191,43 @@ fn an_imperfect_pyramid_of_twenty_rows_stands() {
     assert!(moved < 0.05, "a box moved {moved} m");
 }
 
+/// The speculative margin follows how fast two bodies approach each other,
+/// not how fast each moves (pair_margin in shaders/pairs.wgsl): two boxes
+/// falling side by side 10 cm apart at 5 m/s get no contact (the sum of
+/// their reaches, about 17 cm, made them one), while a box falling at 5 m/s
+/// towards a fixed one 10 cm below gets its contact before they touch and
+/// lands without sinking in.
+#[test]
+fn bodies_falling_together_get_no_contact_and_one_falling_onto_another_does() {
+    let mut scene = scenes::stack(0);
+    let mut left = box_body([0.5; 3], [0.0, 10.0, 0.0]);
+    let mut right = box_body([0.5; 3], [1.1, 10.0, 0.0]);
+    left.linear_velocity = [0.0, -5.0, 0.0];
+    right.linear_velocity = [0.0, -5.0, 0.0];
+    let mut floor = box_body([0.5; 3], [5.0, 20.0, 0.0]);
+    floor.fixed = true;
+    let mut faller = box_body([0.5; 3], [5.0, 21.1, 0.0]);
+    faller.linear_velocity = [0.0, -5.0, 0.0];
+    scene.bodies = vec![left, right, floor, faller];
+    let Some(mut w) = world(&scene) else { return };
+    w.step(1).unwrap();
+    let contacts = w.read_contacts().unwrap();
+    let state = w.read_state().unwrap();
+    let gap = state[1].position[0] - state[0].position[0] - 1.0;
+    eprintln!("side by side: {} and {} contact points, {gap} m apart", contacts[0].len(), contacts[1].len());
+    assert!(contacts[0].is_empty() && contacts[1].is_empty(), "bodies falling together got contacts");
+    assert!((gap - 0.1).abs() < 1e-4, "the pair's gap changed to {gap} m");
+    eprintln!("falling onto a fixed box 10 cm below: {} contact points", contacts[3].len());
+    assert_eq!(contacts[3].len(), 4, "the falling box has no speculative contact with the one below it");
+    let mut deepest = 0.0f32;
+    for _ in 0..30 {
+        w.step(1).unwrap();
+        deepest = deepest.max(21.0 - w.read_state().unwrap()[3].position[1]);
+    }
+    eprintln!("it sank {deepest} m into the fixed box at most");
+    assert!(deepest < 0.005, "the falling box sank {deepest} m into the one below");
+}
+
 #[test]
 fn a_fast_box_does_not_pass_through_a_wall() {
     let mut scene = scenes::stack(0);
