@@ -29,7 +29,7 @@
 // too small when either exceeds its capacity); status[6]: of them, the face
 // contacts left for narrowphase_clip (taken from the top of the pool),
 // status[7]: the others (taken from the bottom); status[2], status[3]: the
-// first numerical fault (see integrate.wgsl): 4 * body + FAULT_* of the
+// first numerical fault (see integrate.wgsl): 8 * body + FAULT_* of the
 // lowest body found bad in the first step that found any, and that step's
 // step_index, both atomicMin-ed from NO_FAULT (0xffffffff, written when the
 // buffer is made); status[8..11]: the narrowphase's indirect dispatch

@@ -59,7 +59,7 @@ struct BodyProps {
     restitution: f32,
     friction: f32,
     kept_inv_mass: f32,      // a body an input made fixed: the inverse mass to restore (1/kg); else 0
-    _pad0: f32,
+    speed_limit: f32,        // the fastest the scene's energy can move it (m/s; see fault_of); 0: none
     shape: u32,              // SHAPE_*
     flags: u32,              // FLAG_* bits
     grid_class: u32,         // GRID_BODY, or LARGE_BODY: kept out of the grid (see grid.wgsl)
@@ -89,7 +89,7 @@ struct Params {
     cell_size: f32,          // edge of a broadphase grid cell (m)
     hash_size: u32,          // buckets of the grid's hash table (a power of two)
     large_count: u32,        // bodies too large for the grid (see large_body())
-    speculative: f32,        // farthest gap (m) at which grid pairs get contacts
+    speed_limits: u32,       // 1: BodyProps' speed_limit holds (no input or edit since the scene began)
     substeps: u32,           // substeps per step: contacts found once serve them all
     step_index: u32,         // the world's step count as this step began (saturates at NO_FAULT - 1)
     sleep_after: f32,        // seconds at rest before a body sleeps; 0: never (settings.sleeping)
@@ -186,9 +186,9 @@ fn contact_ref(manifold: u32, is_b: bool) -> u32 {
     return 2u * manifold + u32(is_b);
 }
 
-// Fastest speed (m/s) at which the solve pushes apart bodies that already
-// overlapped at their previous poses (Box2D's contact push speed is 3 m/s).
-const MAX_DEPENETRATION_SPEED: f32 = 3.0;
+// MAX_DEPENETRATION_SPEED (shared with Rust, src/world.rs): the fastest
+// (m/s) the solve pushes apart bodies that already overlapped at their
+// previous poses.
 
 // Points closer than this (m) still count as touching when restitution is
 // decided after the solve.

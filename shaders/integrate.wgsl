@@ -48,9 +48,20 @@ fn woken(i: u32) -> bool {
 // than MAX_TURN in one substep, whatever MAX_SPIN allows.
 // MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN (m, m/s, rad/s, rad per
 // substep), NO_FAULT (status[3] and status[2] before any fault) and what was
-// wrong, in the low two bits of status[2] (4 * body + FAULT_*):
-// FAULT_NON_FINITE, FAULT_FAR, FAULT_FAST, FAULT_SPIN; shared with Rust
-// (src/world.rs), which decodes them.
+// wrong, in the low three bits of status[2] (8 * body + FAULT_*):
+// FAULT_NON_FINITE, FAULT_FAR, FAULT_FAST, FAULT_SPIN, FAULT_ENERGY; shared
+// with Rust (src/world.rs), which decodes them.
+//
+// A body is also absurd when it moves faster than the scene's energy
+// allows (FAULT_ENERGY): all the energy the scene began with, what gravity
+// can give down to the ground and what pushing out overlap can add, given
+// to this body alone, moves it at BodyProps' speed_limit (twice that speed,
+// for the integration's own error; src/world/records.rs: speed_limits). No
+// collision, joint or restitution of at most 1 adds energy, so a body
+// beyond it was thrown by the solver: fifty boxes placed at one point and
+// landing before they had parted were thrown at 349 m/s, a run that then
+// looked like a success. The limit holds only while nothing else added
+// energy (params.speed_limits: 0 after any input, edit or restore).
 
 // No infinity or NaN (exponent bits all set): WGSL has no isNan, and x != x
 // may be folded away by a driver's fast-math.
@@ -69,7 +80,7 @@ fn usable_rotation(q: vec4<f32>) -> bool {
 }
 
 // FAULT_* of a body's state, or NO_FAULT.
-fn fault_of(s: BodyState) -> u32 {
+fn fault_of(s: BodyState, p: BodyProps) -> u32 {
     let finite = all_finite(vec4<f32>(s.pos, 0.0)) && all_finite(vec4<f32>(s.disp, 0.0))
         && all_finite(s.rot) && all_finite(s.prev_rot);
     if (!finite) {
@@ -82,6 +93,11 @@ fn fault_of(s: BodyState) -> u32 {
     let reach = MAX_SPEED * params.dt_prev;
     if (dot(moved, moved) > reach * reach) {
         return FAULT_FAST;
+    }
+    let allowed = p.speed_limit * params.dt_prev;
+    // (`&`, not `&&`: no branch on a uniform alone, see integrate below)
+    if ((params.speed_limits != 0u) & (p.speed_limit > 0.0) & (dot(moved, moved) > allowed * allowed)) {
+        return FAULT_ENERGY;
     }
     let turned = length(quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))));
     if (turned > min(MAX_TURN, MAX_SPIN * params.dt_prev)) {
@@ -97,7 +113,7 @@ fn report_fault(i: u32, fault: u32) {
     let first = atomicLoad(&status[3]);
     if (first == NO_FAULT || first == params.step_index) {
         atomicMin(&status[3], params.step_index);
-        atomicMin(&status[2], 4u * i + fault);
+        atomicMin(&status[2], 8u * i + fault);
     }
 }
 
@@ -122,7 +138,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = props[i];
     let dt = params.dt;
     let wake = woken(i);
-    let fault = fault_of(s);
+    let fault = fault_of(s, p);
     if (fault != NO_FAULT) {
         report_fault(i, fault);
         var at = vec3<f32>(0.0);

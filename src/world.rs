@@ -157,9 +157,14 @@ pub const MAX_DISTANCE: f32 = 1e6;
 /// in one substep (rad; a pose pair holds under half a turn, pi, per
 /// substep): `MAX_SPIN` and `MAX_TURN` in integrate.wgsl.
 pub const MAX_SPIN: f32 = 1e4;
+/// Fastest speed (m/s) at which the solve pushes apart bodies that already
+/// overlapped at their previous poses (Box2D's contact push speed is 3 m/s);
+/// joints close an old gap no faster (`MAX_DEPENETRATION_SPEED` in the
+/// shaders).
+pub const MAX_DEPENETRATION_SPEED: f32 = 3.0;
 pub const MAX_TURN: f32 = 3.0;
 
-/// What was wrong with a faulted body (the low two bits of `status[2]`,
+/// What was wrong with a faulted body (the low three bits of `status[2]`,
 /// `FAULT_*` in integrate.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FaultKind {
@@ -171,6 +176,9 @@ pub enum FaultKind {
     TooFast = 2,
     /// Spinning faster than `MAX_SPIN`, or turning more than `MAX_TURN` in a substep.
     SpinsTooFast = 3,
+    /// Faster than the scene's energy can move it (`BodyProps::speed_limit`):
+    /// thrown by the solver.
+    FasterThanItsEnergy = 4,
 }
 
 /// The first numerical fault the GPU found: the lowest body found bad in the
@@ -197,6 +205,9 @@ impl std::fmt::Display for Fault {
             FaultKind::SpinsTooFast => {
                 format!("absurd (spinning faster than {MAX_SPIN:e} rad/s or {MAX_TURN} rad in one substep)")
             }
+            FaultKind::FasterThanItsEnergy => "absurd (faster than all the energy of the scene could move it: \
+                                               the solver threw it)"
+                .to_string(),
         };
         write!(f, "body {} became {what} at step {}; it was stopped at its last sane pose", self.body, self.step)
     }
@@ -277,6 +288,9 @@ pub struct World {
     body_count: u32,
     /// Joint islands (`solve_joints` runs only when there are any).
     island_count: u32,
+    /// Whether the bodies' speed limits (`BodyProps::speed_limit`, from the
+    /// scene's energy) still hold: no input, edit or restore since.
+    speed_limits: bool,
     /// Which of `data.states` holds the current state.
     current: usize,
     step: u64,
@@ -403,6 +417,7 @@ impl World {
             large_count: large.len() as u32,
             body_count: n as u32,
             island_count: joints.islands,
+            speed_limits: true,
             current: 0,
             step: 0,
             time: 0.0,
@@ -584,7 +599,7 @@ impl World {
                     cell_size: self.grid.cell_size,
                     hash_size: self.grid.hash_size,
                     large_count: self.large_count,
-                    speculative: self.grid.speculative,
+                    speed_limits: self.speed_limits as u32,
                     substeps: substeps as u32,
                     step_index,
                     sleep_after: if s.sleeping { crate::scene::SLEEP_AFTER } else { 0.0 },
@@ -937,8 +952,14 @@ fn decode_fault(code: u32, step: u32) -> Option<Fault> {
     if step == NO_FAULT || code == NO_FAULT {
         return None;
     }
-    let kind = [FaultKind::NonFinite, FaultKind::TooFar, FaultKind::TooFast, FaultKind::SpinsTooFast][(code & 3) as usize];
-    Some(Fault { body: (code / 4) as usize, step: step as u64, kind })
+    let kind = match code & 7 {
+        0 => FaultKind::NonFinite,
+        1 => FaultKind::TooFar,
+        2 => FaultKind::TooFast,
+        3 => FaultKind::SpinsTooFast,
+        _ => FaultKind::FasterThanItsEnergy,
+    };
+    Some(Fault { body: (code / 8) as usize, step: step as u64, kind })
 }
 
 fn finite_output(b: &BodyOutput) -> bool {

@@ -16,7 +16,7 @@ pub const RESTITUTION: &str = include_str!("../../shaders/restitution.wgsl");
 /// step's passes, the input kernels, the renderer).
 pub fn shared_constants() -> String {
     use crate::gpu::types::*;
-    use crate::world::{FaultKind, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
+    use crate::world::{FaultKind, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
     let mut out = String::from("// Shared with Rust: written by src/gpu/shaders.rs from the Rust constants.\n");
     let words = [
         ("NONE", NONE),
@@ -38,12 +38,18 @@ pub fn shared_constants() -> String {
         ("FAULT_FAR", FaultKind::TooFar as u32),
         ("FAULT_FAST", FaultKind::TooFast as u32),
         ("FAULT_SPIN", FaultKind::SpinsTooFast as u32),
+        ("FAULT_ENERGY", FaultKind::FasterThanItsEnergy as u32),
     ];
     for (name, value) in words {
         out += &wgsl_u32(name, value);
     }
-    for (name, value) in [("MAX_DISTANCE", MAX_DISTANCE), ("MAX_SPEED", MAX_SPEED), ("MAX_SPIN", MAX_SPIN), ("MAX_TURN", MAX_TURN)]
-    {
+    for (name, value) in [
+        ("MAX_DISTANCE", MAX_DISTANCE),
+        ("MAX_SPEED", MAX_SPEED),
+        ("MAX_SPIN", MAX_SPIN),
+        ("MAX_TURN", MAX_TURN),
+        ("MAX_DEPENETRATION_SPEED", MAX_DEPENETRATION_SPEED),
+    ] {
         out += &wgsl_f32(name, value);
     }
     out

@@ -47,7 +47,9 @@ pub struct BodyProps {
     pub friction: f32,
     /// A body an input made fixed: the inverse mass to restore (1/kg); else 0.
     pub kept_inv_mass: f32,
-    pub _pad0: f32,
+    /// The fastest the scene's energy can move the body (m/s; 0: no limit
+    /// but `MAX_SPEED`); see `speed_limits` in src/world/records.rs.
+    pub speed_limit: f32,
     /// `SHAPE_BOX` or `SHAPE_SPHERE`.
     pub shape: u32,
     /// `FLAG_*` bits.
@@ -88,8 +90,9 @@ pub struct Params {
     pub hash_size: u32,
     /// Bodies in the `large` list, outside the grid.
     pub large_count: u32,
-    /// Farthest gap (m) at which pairs found through the grid get contacts.
-    pub speculative: f32,
+    /// 1 while `BodyProps::speed_limit` holds: no input, edit or restore
+    /// has added energy since the scene began.
+    pub speed_limits: u32,
     /// Substeps per step; contacts found once per step serve them all.
     pub substeps: u32,
     /// The world's step count as this step began (saturating at

@@ -204,7 +204,7 @@ impl Shape {
 
     /// Principal moments of inertia (kg·m²) of a solid shape of mass `mass`,
     /// in the body frame, computed in f64.
-    fn inertia_f64(&self, mass: f32) -> [f64; 3] {
+    pub(crate) fn inertia_f64(&self, mass: f32) -> [f64; 3] {
         let m = mass as f64;
         match *self {
             Shape::Box { half_extents: [a, b, c] } => {

@@ -83,6 +83,8 @@ impl World {
         world.step = self.step;
         world.time = self.time;
         world.dt_prev = self.dt_prev;
+        // the kept bodies' energy is not the scene's
+        world.speed_limits = false;
         *self = world;
         Ok(())
     }

@@ -226,12 +226,45 @@ pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
 /// their records) and the grid for the rest.
 pub fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
     let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &scene.settings)).collect();
+    for (p, limit) in props.iter_mut().zip(speed_limits(scene)) {
+        p.speed_limit = limit;
+    }
     let radii: Vec<f32> = props.iter().map(|p| p.half_extents[3]).collect();
     let (large, grid) = plan_grid(&radii);
     for &i in &large {
         props[i as usize].grid_class = LARGE_BODY;
     }
     (props, large, grid)
+}
+
+/// Each body's speed limit (m/s, `BodyProps::speed_limit`; 0: none): twice
+/// the speed at which all the energy the scene can have would move the body
+/// if it alone had it. That energy is what the bodies have as placed
+/// (moving and spinning), what gravity can give them down to the ground
+/// (each centre's height above it: a bound), and what pushing out overlap or closing a joint's gap can add (every
+/// body moved at `MAX_DEPENETRATION_SPEED`). Restitution of at most 1,
+/// friction, damping, contacts and joints add none; twice the speed leaves
+/// the integration's own error room. With gravity but no ground under it
+/// (none, or gravity not straight down) a fall has no bound, and no body
+/// gets a limit; fixed bodies need none.
+pub fn speed_limits(scene: &Scene) -> Vec<f32> {
+    let g = DVec3::from_array(scene.settings.gravity.map(|v| v as f64));
+    let ground = match &scene.ground {
+        Some(ground) if g.x == 0.0 && g.z == 0.0 && g.y <= 0.0 => Some(ground.height as f64),
+        _ if g == DVec3::ZERO => None,
+        _ => return vec![0.0; scene.bodies.len()],
+    };
+    let push = crate::world::MAX_DEPENETRATION_SPEED as f64;
+    let mut energy = 0.0;
+    for b in scene.bodies.iter().filter(|b| !b.fixed) {
+        let m = b.mass as f64;
+        let v = DVec3::from_array(b.linear_velocity.map(|v| v as f64));
+        let w = DVec3::from_array(b.angular_velocity.map(|v| v as f64));
+        let inertia = b.shape.inertia_f64(b.mass).into_iter().fold(0.0, f64::max);
+        let fall = ground.map_or(0.0, |h| -g.y * (b.position[1] as f64 - h).max(0.0));
+        energy += 0.5 * m * (v.length_squared() + push * push) + 0.5 * inertia * w.length_squared() + m * fall;
+    }
+    scene.bodies.iter().map(|b| if b.fixed { 0.0 } else { (2.0 * (2.0 * energy / b.mass as f64).sqrt()) as f32 }).collect()
 }
 
 /// The GPU record of a body's shape, mass and material.
@@ -282,6 +315,36 @@ mod tests {
     use super::*;
     use crate::scene::Joint;
     use crate::scenes::{box_body, stack};
+
+    /// A box of 1000 kg centred 3 m above the ground, another moving at
+    /// 4 m/s on it (centred 0.5 m above it), a fixed one: the energy is
+    /// gravity's 1000 g (3 + 0.5) J (down to the centres' heights: a bound),
+    /// the moving box's 8 kJ and the push allowance, 1000 x 3^2 / 2 J for
+    /// each free box.
+    #[test]
+    fn speed_limits_follow_the_scenes_energy() {
+        let mut scene = stack(0);
+        let mut moving = box_body([0.5; 3], [2.0, 0.5, 0.0]);
+        moving.linear_velocity = [4.0, 0.0, 0.0];
+        let mut fixed = box_body([0.5; 3], [5.0, 0.5, 0.0]);
+        fixed.fixed = true;
+        scene.bodies = vec![box_body([0.5; 3], [0.0, 3.0, 0.0]), moving, fixed];
+        let m = scene.bodies[0].mass as f64;
+        let g = -scene.settings.gravity[1] as f64;
+        let energy = m * g * 3.5 + 0.5 * m * 16.0 + 2.0 * 0.5 * m * 9.0;
+        let limit = (2.0 * (2.0 * energy / m).sqrt()) as f32;
+        let limits = speed_limits(&scene);
+        assert!((limits[0] - limit).abs() < 1e-4 * limit && limits[1] == limits[0], "{limits:?}, expected {limit}");
+        assert_eq!(limits[2], 0.0, "a fixed body needs no limit");
+        // gravity with nothing to stop a fall: no limit
+        scene.ground = None;
+        assert!(speed_limits(&scene).iter().all(|&v| v == 0.0));
+        // no gravity, no ground: what the bodies have and the push
+        scene.settings.gravity = [0.0; 3];
+        let energy = 0.5 * m * 16.0 + 2.0 * 0.5 * m * 9.0;
+        let limit = (2.0 * (2.0 * energy / m).sqrt()) as f32;
+        assert!((speed_limits(&scene)[0] - limit).abs() < 1e-4 * limit);
+    }
 
     /// Islands: a chain pinned to the world at its far end (ordered outward
     /// from the pin), a body held by a fixed one, and a joint between two

@@ -51,7 +51,7 @@
 use std::path::Path;
 
 use super::World;
-use crate::gpu::types::{BodyState, PairMeta, HELD, WOKEN_LAST, WOKEN_NOW};
+use crate::gpu::types::{BodyProps, BodyState, PairMeta, HELD, WOKEN_LAST, WOKEN_NOW};
 use crate::Error;
 
 const MAGIC: &[u8; 8] = b"VRLTSNAP";
@@ -265,6 +265,8 @@ impl World {
         self.step = snapshot.step;
         self.time = snapshot.time;
         self.dt_prev = snapshot.dt_prev;
+        // a snapshot may hold energy the scene did not begin with (inputs)
+        self.speed_limits = false;
         Ok(())
     }
 
@@ -306,7 +308,15 @@ impl World {
         put(&self.grid.hash_size.to_le_bytes());
         put(&self.grid.speculative.to_bits().to_le_bytes());
         put(&self.large_count.to_le_bytes());
-        for buf in std::iter::once(&self.data.props).chain(&self.data.statics) {
+        // the speed limits follow from the rest (and were padding before
+        // them: snapshots from then still belong)
+        let mut props: Vec<BodyProps> =
+            bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.props, self.data.props.size())?);
+        for p in &mut props {
+            p.speed_limit = 0.0;
+        }
+        put(bytemuck::cast_slice(&props));
+        for buf in &self.data.statics {
             put(&self.gpu.read_buffer(buf, buf.size())?);
         }
         Ok(h)

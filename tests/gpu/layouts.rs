@@ -35,7 +35,7 @@ fn shared_structs_match_member_by_member() {
     check_layout!(common, BodyState { pos, rest_time, disp, pos_low, rot, prev_rot });
     check_layout!(
         common,
-        BodyProps { half_extents, inv_inertia, restitution, friction, kept_inv_mass, _pad0, shape, flags, grid_class, _pad1 }
+        BodyProps { half_extents, inv_inertia, restitution, friction, kept_inv_mass, speed_limit, shape, flags, grid_class, _pad1 }
     );
     check_layout!(common, Velocity { linear, angular });
     check_layout!(
@@ -55,7 +55,7 @@ fn shared_structs_match_member_by_member() {
             cell_size,
             hash_size,
             large_count,
-            speculative,
+            speed_limits,
             substeps,
             step_index,
             sleep_after,
