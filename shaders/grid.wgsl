@@ -3,13 +3,15 @@
 // is unbounded; a bucket may hold bodies of several cells, which the
 // narrowphase tells apart by each body's own cell.
 //
-//   grid_clear        buckets: count = 0
 //   grid_count        bodies:  count[bucket of body]++
 //   scan_blocks       buckets: exclusive prefix sum within blocks of SCAN_BLOCK
 //   scan_sums         one workgroup: prefix sum of the block totals
-//   scan_add          buckets: add block offsets -> cell_start; count = 0 again
-//   grid_scatter      bodies:  sorted[cell_start + count++] = body
+//   scan_add          buckets: add block offsets -> cell_start
+//   grid_scatter      bodies:  sorted[cell_start + --count] = body
 //   grid_sort         buckets: sort each bucket's bodies by index (determinism)
+//
+// The scatter counts each bucket back down to 0, so the counts are 0 again
+// for the next step without a pass to clear them (a new buffer is zeroed).
 //
 // Large bodies (much bigger than a cell; large_body()) are not in the grid.
 //
@@ -31,19 +33,6 @@ fn bucket_of(c: vec3<i32>) -> u32 {
 
 fn in_grid(i: u32) -> bool {
     return props[i].grid_class == GRID_BODY;
-}
-
-@compute @workgroup_size(WORKGROUP)
-fn grid_clear(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x < params.hash_size) {
-        atomicStore(&cell_count[gid.x], 0u);
-    }
-    if (gid.x == 0u) {
-        // the manifold pool fills anew
-        atomicStore(&status[4], 0u);
-        atomicStore(&status[6], 0u);
-        atomicStore(&status[7], 0u);
-    }
 }
 
 // How far body i may move in the coming step, all its substeps (m): its last
@@ -70,10 +59,16 @@ fn world_extent(i: u32) -> vec3<f32> {
 }
 
 // Counts body i into its bucket and writes what the pair list reads of it
-// (PairMeta's moves, extent and reach; see pairs.wgsl).
+// (PairMeta's moves, extent and reach; see pairs.wgsl). Invocation 0 also
+// empties the manifold pool's counters (the step's first pass).
 @compute @workgroup_size(WORKGROUP)
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
+    if (i == 0u) {
+        atomicStore(&status[4], 0u);
+        atomicStore(&status[6], 0u);
+        atomicStore(&status[7], 0u);
+    }
     if (i >= params.body_count) {
         return;
     }
@@ -203,11 +198,10 @@ fn scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
     if (h < scan_len()) {
         scan_write(h, scan_start(h) + block_sums[h / SCAN_BLOCK]);
-        // the counts start again: pairs_write fills by them
+        // the narrowphase lists contacts by the cursors from 0 (the
+        // grid's counts stay: the scatter counts them down)
         if (SCAN_PAIRS) {
             atomicStore(&pair_meta[h].cursor, 0u);
-        } else {
-            atomicStore(&cell_count[h], 0u);
         }
     }
 }
@@ -219,7 +213,7 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let h = bucket_of(cell_of(state_in[i].pos));
-    sorted[cell_start[h] + atomicAdd(&cell_count[h], 1u)] = i;
+    sorted[cell_start[h] + atomicSub(&cell_count[h], 1u) - 1u] = i;
 }
 
 // The scatter's order within a bucket depends on thread timing; sorting each

@@ -26,7 +26,6 @@ use crate::gpu::{shaders, types::*, Gpu};
 /// and the labels of their compute passes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
-    GridClear,
     GridCount,
     GridScanBlocks,
     GridScanSums,
@@ -127,8 +126,7 @@ impl Buffer {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 22] = [
-        Stage::GridClear,
+    pub const ALL: [Stage; 21] = [
         Stage::GridCount,
         Stage::GridScanBlocks,
         Stage::GridScanSums,
@@ -156,7 +154,6 @@ impl Stage {
     /// but for the scan passes (see `entry_point`).
     pub fn name(self) -> &'static str {
         match self {
-            Stage::GridClear => "grid_clear",
             Stage::GridCount => "grid_count",
             Stage::GridScanBlocks => "grid_scan_blocks",
             Stage::GridScanSums => "grid_scan_sums",
@@ -221,7 +218,6 @@ impl Stage {
     pub fn reads(self) -> &'static [Buffer] {
         use Buffer::*;
         match self {
-            Stage::GridClear => &[Params],
             Stage::GridCount => &[Params, Props, StateIn, CellCount, PairMeta],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
@@ -247,11 +243,10 @@ impl Stage {
     pub fn writes(self) -> &'static [Buffer] {
         use Buffer::*;
         match self {
-            Stage::GridClear => &[CellCount, Status],
-            Stage::GridCount => &[CellCount, PairMeta],
+            Stage::GridCount => &[CellCount, Status, PairMeta],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[CellStart, BlockSums, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[CellStart, BlockSums, Status, PairMeta],
-            Stage::GridScanAdd | Stage::PairsScanAdd => &[CellCount, CellStart, PairMeta],
+            Stage::GridScanAdd | Stage::PairsScanAdd => &[CellStart, PairMeta],
             Stage::GridScatter => &[CellCount, Sorted],
             Stage::GridSort => &[Sorted],
             Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
@@ -303,7 +298,7 @@ impl Stage {
 
     pub fn over(self) -> Over {
         match self {
-            Stage::GridClear | Stage::GridScanAdd | Stage::GridSort => Over::Buckets,
+            Stage::GridScanAdd | Stage::GridSort => Over::Buckets,
             Stage::GridScanBlocks => Over::ScanBlocks,
             Stage::GridScanSums | Stage::PairsScanSums => Over::One,
             Stage::PairsScanBlocks => Over::BodyScanBlocks,
