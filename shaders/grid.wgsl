@@ -6,7 +6,8 @@
 //   grid_count        bodies:  count[bucket of body]++
 //   scan_blocks       buckets: exclusive prefix sum within blocks of SCAN_BLOCK
 //   scan_sums         one workgroup: prefix sum of the block totals
-//   scan_add          buckets: add block offsets -> cell_start
+//   scan_add          buckets: add block offsets -> cell_start (the grid's
+//                     alone: pairs_write adds the pairs' own)
 //   grid_scatter      bodies:  sorted[cell_start + --count] = body
 //   grid_sort         buckets: sort each bucket's bodies by index (determinism)
 //
@@ -15,10 +16,11 @@
 //
 // Large bodies (much bigger than a cell; large_body()) are not in the grid.
 //
-// The three scan passes serve the pair pipeline too (pairs.wgsl): with the
-// override constant SCAN_PAIRS they sum the bodies' pair counts instead
-// (pair_meta's owned and total -> owned_start and list_start), and the
-// single workgroup also writes the narrowphase's indirect dispatch.
+// The first two scan passes serve the pair pipeline too (pairs.wgsl): with
+// the override constant SCAN_PAIRS they sum the bodies' pair counts instead
+// (pair_meta's owned and total -> owned_start and list_start, within their
+// blocks), and the single workgroup also writes the narrowphase's indirect
+// dispatch; pairs_write adds each body's block offset (no third pass).
 
 // SCAN_BLOCK: buckets (or bodies) summed per workgroup (shared with Rust).
 
@@ -111,13 +113,6 @@ fn scan_write(k: u32, v: vec2<u32>) {
     }
 }
 
-fn scan_start(k: u32) -> vec2<u32> {
-    if (SCAN_PAIRS) {
-        return vec2<u32>(pair_meta[k].owned_start, pair_meta[k].list_start);
-    }
-    return vec2<u32>(cell_start[k], 0u);
-}
-
 var<workgroup> scan_tmp: array<vec2<u32>, SCAN_BLOCK>;
 
 // Inclusive Hillis-Steele scan of scan_tmp; every invocation must call it.
@@ -193,16 +188,12 @@ fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
     }
 }
 
+// (The grid's: the counts stay, the scatter counts them down.)
 @compute @workgroup_size(WORKGROUP)
 fn scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
     if (h < scan_len()) {
-        scan_write(h, scan_start(h) + block_sums[h / SCAN_BLOCK]);
-        // the narrowphase lists contacts by the cursors from 0 (the
-        // grid's counts stay: the scatter counts them down)
-        if (SCAN_PAIRS) {
-            atomicStore(&pair_meta[h].cursor, 0u);
-        }
+        cell_start[h] = cell_start[h] + block_sums[h / SCAN_BLOCK].x;
     }
 }
 

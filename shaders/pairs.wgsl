@@ -3,18 +3,21 @@
 //
 //   pairs_count   bodies: walk the body's own grid cell and the 13 cells
 //                 ahead of it, and the large bodies; count the pairs it
-//                 owns, and count each into its partner's incoming pairs
+//                 owns, count each into its partner's incoming pairs
 //                 (pair_meta's cursor, an integer atomic: the sum does not
-//                 depend on the order)
-//   scan_*        (grid.wgsl, SCAN_PAIRS) prefix sums of the owned and of all
-//                 pairs (where each body's pairs and its contact list
-//                 start), the narrowphase's indirect dispatch; the cursors
-//                 start again from 0
-//                 and note each partner in the body's scratch room (a
-//                 run of body_pairs by grid order, before the lists fill it)
-//   pairs_write   bodies: copy the owned pairs from the scratch room to the
-//                 body's offset, in the order the walk found them (a body
-//                 that owns more than its room holds walks again)
+//                 depend on the order), and note each partner in the body's
+//                 scratch room (a run of body_pairs by grid order, before
+//                 the lists fill it)
+//   pairs_scan_*  (grid.wgsl's scan_blocks and scan_sums, SCAN_PAIRS)
+//                 prefix sums of the owned and of all pairs within blocks
+//                 of bodies (where each body's pairs and its contact list
+//                 start), the blocks' offsets, the narrowphase's indirect
+//                 dispatch
+//   pairs_write   bodies: add the block's offset to the body's starts, set
+//                 its cursor to 0 again, and copy its owned pairs from the
+//                 scratch room to its place, in the order the walk found
+//                 them (a body that owns more than its room holds walks
+//                 again)
 //
 // A body's list (body_pairs from list_start, room for all its pairs) is
 // filled later, by the narrowphase, with the pairs that have a manifold,
@@ -221,6 +224,13 @@ fn pairs_write(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let i = sorted[gid.x];
+    // the scan left the body's starts within its block of SCAN_BLOCK
+    // bodies: add the block's offset; the narrowphase lists contacts by the
+    // cursor from 0
+    let offset = block_sums[i / SCAN_BLOCK];
+    pair_meta[i].owned_start = pair_meta[i].owned_start + offset.x;
+    pair_meta[i].list_start = pair_meta[i].list_start + offset.y;
+    atomicStore(&pair_meta[i].cursor, 0u);
     let count = pair_meta[i].owned;
     if (count > scratch_room()) {
         writing = true;

@@ -35,7 +35,6 @@ pub enum Stage {
     PairsCount,
     PairsScanBlocks,
     PairsScanSums,
-    PairsScanAdd,
     PairsWrite,
     Narrowphase,
     NarrowphaseGround,
@@ -126,7 +125,7 @@ impl Buffer {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 21] = [
+    pub const ALL: [Stage; 20] = [
         Stage::GridCount,
         Stage::GridScanBlocks,
         Stage::GridScanSums,
@@ -136,7 +135,6 @@ impl Stage {
         Stage::PairsCount,
         Stage::PairsScanBlocks,
         Stage::PairsScanSums,
-        Stage::PairsScanAdd,
         Stage::PairsWrite,
         Stage::Narrowphase,
         Stage::NarrowphaseGround,
@@ -163,7 +161,6 @@ impl Stage {
             Stage::PairsCount => "pairs_count",
             Stage::PairsScanBlocks => "pairs_scan_blocks",
             Stage::PairsScanSums => "pairs_scan_sums",
-            Stage::PairsScanAdd => "pairs_scan_add",
             Stage::PairsWrite => "pairs_write",
             Stage::Narrowphase => "narrowphase",
             Stage::NarrowphaseGround => "narrowphase_ground",
@@ -185,7 +182,7 @@ impl Stage {
         match self {
             Stage::GridScanBlocks | Stage::PairsScanBlocks => "scan_blocks",
             Stage::GridScanSums | Stage::PairsScanSums => "scan_sums",
-            Stage::GridScanAdd | Stage::PairsScanAdd => "scan_add",
+            Stage::GridScanAdd => "scan_add",
             other => other.name(),
         }
     }
@@ -221,11 +218,13 @@ impl Stage {
             Stage::GridCount => &[Params, Props, StateIn, CellCount, PairMeta],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
-            Stage::GridScanAdd | Stage::PairsScanAdd => &[Params, CellStart, BlockSums, PairMeta],
+            Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
             Stage::GridSort => &[Params, CellStart, Sorted],
             Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta],
-            Stage::PairsWrite => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta, BodyPairs],
+            Stage::PairsWrite => {
+                &[Params, Props, StateIn, CellStart, BlockSums, Sorted, JointStart, JointRefs, PairMeta, BodyPairs]
+            }
             Stage::Narrowphase => &[Params, Props, StateIn, Pairs, Status, PairMeta],
             Stage::NarrowphaseGround => &[Params, Props, StateIn, Pairs, Status, PairMeta],
             Stage::ContactLists => &[Params, Manifolds, Status, PairMeta, BodyPairs],
@@ -246,7 +245,7 @@ impl Stage {
             Stage::GridCount => &[CellCount, Status, PairMeta],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[CellStart, BlockSums, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[CellStart, BlockSums, Status, PairMeta],
-            Stage::GridScanAdd | Stage::PairsScanAdd => &[CellStart, PairMeta],
+            Stage::GridScanAdd => &[CellStart],
             Stage::GridScatter => &[CellCount, Sorted],
             Stage::GridSort => &[Sorted],
             Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
@@ -281,7 +280,7 @@ impl Stage {
     /// Whether the stage is one of grid.wgsl's scan passes run over the
     /// bodies' pair counts (its override constant SCAN_PAIRS).
     pub fn scans_pairs(self) -> bool {
-        matches!(self, Stage::PairsScanBlocks | Stage::PairsScanSums | Stage::PairsScanAdd)
+        matches!(self, Stage::PairsScanBlocks | Stage::PairsScanSums)
     }
 
     /// Whether the pass edits the current state in place: it is bound
