@@ -4,11 +4,11 @@
 // narrowphase tells apart by each body's own cell.
 //
 //   grid_count        bodies:  count[bucket of body]++
-//   scan_blocks       buckets: exclusive prefix sum within blocks of SCAN_BLOCK
+//   scan_blocks       buckets: exclusive prefix sum within blocks of SCAN_SPAN
 //   scan_sums         one workgroup: prefix sum of the block totals
 //   scan_add          buckets: add block offsets -> cell_start (the grid's
 //                     alone: pairs_write adds the pairs' own)
-//   grid_scatter      bodies:  sorted[cell_start + --count] = body
+//   grid_scatter      bodies:  sorted[cell_end - count--] = body
 //   grid_sort         buckets: sort each bucket's bodies by index (determinism)
 //
 // The scatter counts each bucket back down to 0, so the counts are 0 again
@@ -22,7 +22,9 @@
 // blocks), and the single workgroup also writes the narrowphase's indirect
 // dispatch; pairs_write adds each body's block offset (no third pass).
 
-// SCAN_BLOCK: buckets (or bodies) summed per workgroup (shared with Rust).
+// SCAN_BLOCK: invocations of a scan workgroup; SCAN_RUN: buckets (or
+// bodies) each sums in turn; SCAN_SPAN: their product, a block (shared with
+// Rust).
 
 fn cell_of(p: vec3<f32>) -> vec3<i32> {
     return vec3<i32>(floor(p / params.cell_size));
@@ -129,21 +131,36 @@ fn scan_workgroup(lid: u32) {
     workgroupBarrier();
 }
 
-@compute @workgroup_size(SCAN_BLOCK)
-fn scan_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>,
-               @builtin(workgroup_id) wid: vec3<u32>) {
-    let h = gid.x;
-    var v = vec2<u32>(0u);
-    if (h < scan_len()) {
-        v = scan_read(h);
+fn scan_written(k: u32) -> vec2<u32> {
+    if (SCAN_PAIRS) {
+        return vec2<u32>(pair_meta[k].owned_start, pair_meta[k].list_start);
     }
-    scan_tmp[lid.x] = v;
-    scan_workgroup(lid.x);
-    if (h < scan_len()) {
-        scan_write(h, scan_tmp[lid.x] - v); // exclusive
+    return vec2<u32>(cell_start[k], 0u);
+}
+
+// A block is SCAN_SPAN = SCAN_BLOCK x SCAN_RUN elements: each invocation
+// sums a run of SCAN_RUN in turn, then the workgroup scans the runs' totals
+// (its barriers, not the sums, are what such a pass costs on lavapipe: with
+// one element an invocation the grid's scan took 2.7 ms a step at 10k
+// bodies).
+@compute @workgroup_size(SCAN_BLOCK)
+fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_id) wid: vec3<u32>) {
+    let first = wid.x * SCAN_SPAN + lid.x * SCAN_RUN;
+    let end = min(first + SCAN_RUN, scan_len());
+    var total = vec2<u32>(0u);
+    for (var h = first; h < end; h = h + 1u) {
+        let v = scan_read(h);
+        scan_write(h, total); // exclusive within the run
         if (SCAN_PAIRS) {
             pair_meta[h].total = v.y;
         }
+        total = total + v;
+    }
+    scan_tmp[lid.x] = total;
+    scan_workgroup(lid.x);
+    let before = scan_tmp[lid.x] - total;
+    for (var h = first; h < end; h = h + 1u) {
+        scan_write(h, scan_written(h) + before); // exclusive within the block
     }
     if (lid.x == SCAN_BLOCK - 1u) {
         block_sums[wid.x] = scan_tmp[lid.x];
@@ -154,7 +171,7 @@ fn scan_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
 // invocation scanning a run of consecutive blocks first.
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
-    let blocks = (scan_len() + SCAN_BLOCK - 1u) / SCAN_BLOCK;
+    let blocks = (scan_len() + SCAN_SPAN - 1u) / SCAN_SPAN;
     let run = (blocks + SCAN_BLOCK - 1u) / SCAN_BLOCK;
     let first = lid.x * run;
     var total = vec2<u32>(0u);
@@ -193,7 +210,7 @@ fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
 fn scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
     if (h < scan_len()) {
-        cell_start[h] = cell_start[h] + block_sums[h / SCAN_BLOCK].x;
+        cell_start[h] = cell_start[h] + block_sums[h / SCAN_SPAN].x;
     }
 }
 
@@ -204,7 +221,9 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let h = bucket_of(cell_of(state_in[i].pos));
-    sorted[cell_start[h] + atomicSub(&cell_count[h], 1u) - 1u] = i;
+    // from the bucket's start as the count goes down (in arrival order,
+    // which is mostly by index: grid_sort then has little to move)
+    sorted[cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
 }
 
 // The scatter's order within a bucket depends on thread timing; sorting each

@@ -224,10 +224,10 @@ fn pairs_write(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let i = sorted[gid.x];
-    // the scan left the body's starts within its block of SCAN_BLOCK
+    // the scan left the body's starts within its block of SCAN_SPAN
     // bodies: add the block's offset; the narrowphase lists contacts by the
     // cursor from 0
-    let offset = block_sums[i / SCAN_BLOCK];
+    let offset = block_sums[i / SCAN_SPAN];
     pair_meta[i].owned_start = pair_meta[i].owned_start + offset.x;
     pair_meta[i].list_start = pair_meta[i].list_start + offset.y;
     atomicStore(&pair_meta[i].cursor, 0u);

@@ -348,7 +348,7 @@ impl World {
         let cell_count = storage("grid/cell_count", 4 * hash);
         let cell_start = storage("grid/cell_start", 4 * (hash + 1));
         // block totals of the grid's scan and the pairs' (xy)
-        let block_sums = storage("scan/block_sums", 8 * hash.max(count as u64).div_ceil(SCAN_BLOCK as u64));
+        let block_sums = storage("scan/block_sums", 8 * hash.max(count as u64).div_ceil(SCAN_SPAN as u64));
         let sorted = storage("grid/sorted", 4 * count as u64);
         let large_buf = with_data("grid/large", bytemuck::cast_slice(&large));
         let (pair_capacity, manifold_capacity) = pair_capacities(&gpu, count as u64);
@@ -815,8 +815,8 @@ impl World {
         let n = match over {
             Over::Bodies => self.body_count.div_ceil(WORKGROUP),
             Over::Buckets => self.grid.hash_size.div_ceil(WORKGROUP),
-            Over::ScanBlocks => self.grid.hash_size.div_ceil(SCAN_BLOCK),
-            Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_BLOCK),
+            Over::ScanBlocks => self.grid.hash_size.div_ceil(SCAN_SPAN),
+            Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_SPAN),
             Over::One => 1,
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
             Over::Pairs | Over::Manifolds => unreachable!("dispatched indirectly"),

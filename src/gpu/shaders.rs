@@ -31,6 +31,8 @@ pub fn shared_constants() -> String {
         ("LARGE_BODY", LARGE_BODY),
         ("WORKGROUP", WORKGROUP),
         ("SCAN_BLOCK", SCAN_BLOCK),
+        ("SCAN_RUN", SCAN_RUN),
+        ("SCAN_SPAN", SCAN_SPAN),
         ("WOKEN_NOW", WOKEN_NOW),
         ("WOKEN_LAST", WOKEN_LAST),
         ("NO_FAULT", NO_FAULT),

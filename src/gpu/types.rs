@@ -235,8 +235,12 @@ pub const GROUND: u32 = u32::MAX;
 pub const MAX_POINTS: u32 = 4;
 /// No pair / no manifold (`NONE` in WGSL).
 pub const NONE: u32 = u32::MAX;
-/// Buckets summed per workgroup by the grid scan (`SCAN_BLOCK` in WGSL).
+/// Invocations of a scan workgroup (`SCAN_BLOCK` in WGSL).
 pub const SCAN_BLOCK: u32 = 256;
+/// Buckets (or bodies) each invocation of a scan sums in turn (`SCAN_RUN`).
+pub const SCAN_RUN: u32 = 8;
+/// Buckets (or bodies) a scan workgroup sums: a block (`SCAN_SPAN`).
+pub const SCAN_SPAN: u32 = SCAN_BLOCK * SCAN_RUN;
 
 /// `BodyProps::shape`.
 pub const SHAPE_BOX: u32 = 0;

@@ -53,9 +53,9 @@ pub enum Stage {
 pub enum Over {
     Bodies,
     Buckets,
-    /// One workgroup of `SCAN_BLOCK` per block of buckets.
+    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` buckets.
     ScanBlocks,
-    /// One workgroup of `SCAN_BLOCK` per block of bodies.
+    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` bodies.
     BodyScanBlocks,
     /// A single workgroup.
     One,
@@ -216,7 +216,7 @@ impl Stage {
         use Buffer::*;
         match self {
             Stage::GridCount => &[Params, Props, StateIn, CellCount, PairMeta],
-            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, PairMeta],
+            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, CellStart, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],

@@ -26,10 +26,11 @@ fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
 
 #[test]
 fn the_pair_pools_grow_for_a_crowded_scene() {
-    // an 8 x 8 x 8 lattice of balls 0.55 diameters apart, no gravity: every
-    // ball overlaps its 26 lattice neighbours, all of them candidates (about
-    // 10 owned pairs a body, more than the list holds at first)
-    let side = 8usize;
+    // a 13 x 13 x 13 lattice of balls 0.55 diameters apart, no gravity:
+    // every ball overlaps its 26 lattice neighbours, all of them candidates
+    // (about 10 owned pairs a body, more than the list holds at first); 2197
+    // bodies, so the pair scan spans two blocks (SCAN_SPAN)
+    let side = 13usize;
     let mut scene = scenes::stack(0);
     scene.ground = None;
     scene.settings.gravity = [0.0; 3];

@@ -5,6 +5,7 @@
 use crate::common::world;
 use crate::common::Rng;
 use glam::{Quat, Vec3};
+use verlet::gpu::types::SCAN_SPAN;
 use verlet::scenes::{box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
 use verlet::world::plan_grid;
@@ -27,10 +28,12 @@ fn grid_stages() -> Vec<Stage> {
 fn the_grid_is_a_counting_sort_by_bucket() {
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let mut bodies = Vec::new();
-    for k in 0..700 {
+    // 2500 bodies: 8192 buckets, four blocks of the scan (SCAN_SPAN)
+    for k in 0..2500 {
         let at = [40.0 * rng.f() - 20.0, 30.0 * rng.f() - 5.0, 40.0 * rng.f() - 20.0];
         bodies.push(if k % 3 == 0 { sphere_body(0.2 + 0.3 * rng.f(), at) } else { box_body([0.3, 0.2 + 0.2 * rng.f(), 0.4], at) });
     }
+    assert!(plan_grid(&[0.5; 2502]).1.hash_size > 2 * SCAN_SPAN);
     // two bodies too large for the cells
     bodies.push(box_body([6.0, 0.5, 6.0], [0.0, -3.0, 0.0]));
     bodies.push(sphere_body(4.0, [10.0, 10.0, 10.0]));
@@ -48,7 +51,7 @@ fn the_grid_is_a_counting_sort_by_bucket() {
 
     let radii: Vec<f32> = scene.bodies.iter().map(|b| b.bounding_radius()).collect();
     let (large, grid) = plan_grid(&radii);
-    assert_eq!(large, [700, 701], "the two large bodies are kept out of the grid");
+    assert_eq!(large, [2500, 2501], "the two large bodies are kept out of the grid");
     let states = w.read_raw().unwrap();
     let bucket = |i: usize| {
         let p = Vec3::from(states[i].pos);
@@ -58,12 +61,12 @@ fn the_grid_is_a_counting_sort_by_bucket() {
             ^ (c.z as i32 as u32).wrapping_mul(83_492_791);
         h & (grid.hash_size - 1)
     };
-    let mut expected: Vec<u32> = (0..700).collect();
+    let mut expected: Vec<u32> = (0..2500).collect();
     expected.sort_by_key(|&i| (bucket(i as usize), i));
     expected.extend(&large);
-    assert_eq!(&sorted[..702], &expected[..], "sorted");
+    assert_eq!(&sorted[..2502], &expected[..], "sorted");
     let mut starts = vec![0u32; grid.hash_size as usize + 1];
-    for i in 0..700 {
+    for i in 0..2500 {
         starts[bucket(i) as usize + 1] += 1;
     }
     for h in 0..grid.hash_size as usize {

@@ -101,6 +101,8 @@ fn constants_match() {
         ("LARGE_BODY", LARGE_BODY),
         ("WORKGROUP", WORKGROUP),
         ("SCAN_BLOCK", SCAN_BLOCK),
+        ("SCAN_RUN", SCAN_RUN),
+        ("SCAN_SPAN", SCAN_SPAN),
         ("WOKEN_NOW", WOKEN_NOW),
         ("WOKEN_LAST", WOKEN_LAST),
         ("MAX_POINTS", MAX_POINTS),
