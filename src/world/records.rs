@@ -241,8 +241,9 @@ pub fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
 /// the speed at which all the energy the scene can have would move the body
 /// if it alone had it. That energy is what the bodies have as placed
 /// (moving and spinning), what gravity can give them down to the ground
-/// (each centre's height above it: a bound), and what pushing out overlap or closing a joint's gap can add (every
-/// body moved at `MAX_DEPENETRATION_SPEED`). Restitution of at most 1,
+/// (each centre's height above it: a bound), and what pushing out overlap
+/// or closing a joint's gap can add (every body moved at
+/// `MAX_DEPENETRATION_SPEED`). Restitution of at most 1,
 /// friction, damping, contacts and joints add none; twice the speed leaves
 /// the integration's own error room. With gravity but no ground under it
 /// (none, or gravity not straight down) a fall has no bound, and no body
