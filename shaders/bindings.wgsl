@@ -106,10 +106,10 @@ fn contact_end(i: u32) -> ContactEnd {
     if (i == GROUND) {
         let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), false,
-                          params.ground_restitution, params.ground_friction);
+                          params.ground_restitution, params.ground_friction, 0.0);
     }
     let s = state_in[i];
     let p = props[i];
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
-                      p.restitution, p.friction);
+                      p.restitution, p.friction, select(0.0, p.half_extents.x, p.shape == SHAPE_SPHERE));
 }

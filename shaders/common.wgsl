@@ -305,6 +305,20 @@ struct ContactEnd {
     moves: bool,            // awake and not fixed: the contacts may move it
     restitution: f32,
     friction: f32,
+    radius: f32,            // a sphere's radius (m); 0 for a box or the ground
+}
+
+// The point of an end a contact of normal `toward` (pointing from the end
+// to its partner) measures, in the end's frame: the stored point, or for a
+// sphere the point of its surface that faces the partner now. A sphere's
+// material point found at the step's start turns away with its spin (a
+// ball rolling at 13 m/s turns 0.7 rad a step), and one measured there
+// read the ball as above the ground while it sank through it.
+fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
+    if (e.radius > 0.0) {
+        return quat_rotate(quat_conj(e.rot), toward * e.radius);
+    }
+    return stored;
 }
 
 // Generalised inverse mass of an end for a unit push along dir at offset r;

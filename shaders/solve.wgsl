@@ -103,14 +103,16 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     var all_depth = 0.0;
     for (var q = 0u; q < manifolds[k].count; q = q + 1u) {
         let pt = manifolds[k].points[q];
-        let ra = quat_rotate(ea.rot, pt.local_a);
-        let rb = quat_rotate(eb.rot, pt.local_b);
+        let local_a = end_point(ea, pt.local_a, n);
+        let local_b = end_point(eb, pt.local_b, -n);
+        let ra = quat_rotate(ea.rot, local_a);
+        let rb = quat_rotate(eb.rot, local_b);
         let on_a = ea.pos + ra;
         let on_b = eb.pos + rb;
         // how far each material point moved since the previous poses, from
         // the displacements (no difference of two far-out positions)
-        let moved_a = ea.disp + (ra - quat_rotate(ea.prev_rot, pt.local_a));
-        let moved_b = eb.disp + (rb - quat_rotate(eb.prev_rot, pt.local_b));
+        let moved_a = ea.disp + (ra - quat_rotate(ea.prev_rot, local_a));
+        let moved_b = eb.disp + (rb - quat_rotate(eb.prev_rot, local_b));
         // Overlap the bodies already had at their previous poses is pushed
         // out at no more than MAX_DEPENETRATION_SPEED: a full snap in one
         // substep would turn into that much velocity (Verlet), and deep
