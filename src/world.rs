@@ -640,12 +640,54 @@ impl World {
         self.copy_batch_start(&mut encoder);
         let plan = self.step_plan();
         for first in (0..slot).step_by(substeps) {
-            for &(stage, sub) in &plan {
-                self.encode_pass(&mut encoder, stage, first + sub, None);
-            }
+            self.encode_step(&mut encoder, &plan, first);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.finish_steps(dts, substeps);
+    }
+
+    /// Records one step's dispatches (`plan`, its substeps' Params from batch
+    /// slot `first` on) in as few compute passes as the copies of the
+    /// indirect dispatch sizes allow: three. A pass of its own for every
+    /// dispatch cost lavapipe about 30 us more a dispatch, a third of a
+    /// small scene's step (`encode_pass` does so, for `profile`'s
+    /// timestamps).
+    fn encode_step(&mut self, encoder: &mut wgpu::CommandEncoder, plan: &[(Stage, usize)], first: usize) {
+        let mut pass: Option<wgpu::ComputePass<'static>> = None;
+        for &(stage, sub) in plan {
+            if stage == Stage::Narrowphase {
+                drop(pass.take());
+                encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12);
+            }
+            let open = pass.get_or_insert_with(|| {
+                encoder
+                    .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("step"), timestamp_writes: None })
+                    .forget_lifetime()
+            });
+            self.dispatch(open, stage, first + sub);
+            if stage == Stage::ContactLists {
+                drop(pass.take());
+                encoder.copy_buffer_to_buffer(&self.data.status, 48, &self.data.dispatch, 16, 12);
+            }
+            if stage.flips_state() {
+                self.current = 1 - self.current;
+            }
+        }
+    }
+
+    /// Records `stage`'s dispatch with the Params of batch slot `slot`, bound
+    /// to the current state.
+    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, stage: Stage, slot: usize) {
+        let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
+        pass.set_pipeline(self.pipelines.pipeline(stage));
+        let groups = self.data.bind_groups.as_ref().expect("made with the buffers");
+        let group = if stage.edits_in_place() { 1 - self.current } else { self.current };
+        pass.set_bind_group(0, &groups[group], &offset);
+        match stage.over() {
+            Over::Pairs => pass.dispatch_workgroups_indirect(&self.data.dispatch, 0),
+            Over::Manifolds => pass.dispatch_workgroups_indirect(&self.data.dispatch, 16),
+            over => pass.dispatch_workgroups(self.workgroups(over), 1, 1),
+        }
     }
 
     /// The passes of one step, each with the substep whose Params it uses:
@@ -677,22 +719,13 @@ impl World {
         slot: usize,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
         if stage == Stage::Narrowphase {
             // the pair scan wrote the dispatch's size into status[8..11]
             encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12);
         }
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(stage.name()), timestamp_writes: timestamps });
-        pass.set_pipeline(self.pipelines.pipeline(stage));
-        let groups = self.data.bind_groups.as_ref().expect("made with the buffers");
-        let group = if stage.edits_in_place() { 1 - self.current } else { self.current };
-        pass.set_bind_group(0, &groups[group], &offset);
-        match stage.over() {
-            Over::Pairs => pass.dispatch_workgroups_indirect(&self.data.dispatch, 0),
-            Over::Manifolds => pass.dispatch_workgroups_indirect(&self.data.dispatch, 16),
-            over => pass.dispatch_workgroups(self.workgroups(over), 1, 1),
-        }
+        self.dispatch(&mut pass, stage, slot);
         drop(pass);
         if stage == Stage::ContactLists {
             // the contact passes' dispatch, written into status[12..15]
