@@ -657,8 +657,8 @@ impl World {
         for &(stage, sub) in plan {
             if stage == Stage::Narrowphase {
                 drop(pass.take());
-                encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12);
             }
+            self.copy_dispatch_sizes(encoder, stage, true);
             let open = pass.get_or_insert_with(|| {
                 encoder
                     .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("step"), timestamp_writes: None })
@@ -667,17 +667,26 @@ impl World {
             self.dispatch(open, stage, first + sub);
             if stage == Stage::ContactLists {
                 drop(pass.take());
-                encoder.copy_buffer_to_buffer(&self.data.status, 48, &self.data.dispatch, 16, 12);
             }
-            if stage.flips_state() {
-                self.current = 1 - self.current;
-            }
+            self.copy_dispatch_sizes(encoder, stage, false);
+        }
+    }
+
+    /// The copies of the indirect dispatch sizes around `stage` (`before`
+    /// it runs, or after): the narrowphase's, which the pair scan wrote into
+    /// status[8..11], before it; the contact passes', which contact_lists
+    /// wrote into status[12..15], after that. Outside any compute pass.
+    fn copy_dispatch_sizes(&self, encoder: &mut wgpu::CommandEncoder, stage: Stage, before: bool) {
+        match (stage, before) {
+            (Stage::Narrowphase, true) => encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12),
+            (Stage::ContactLists, false) => encoder.copy_buffer_to_buffer(&self.data.status, 48, &self.data.dispatch, 16, 12),
+            _ => {}
         }
     }
 
     /// Records `stage`'s dispatch with the Params of batch slot `slot`, bound
-    /// to the current state.
-    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, stage: Stage, slot: usize) {
+    /// to the current state, and flips the current state if it writes.
+    fn dispatch(&mut self, pass: &mut wgpu::ComputePass<'_>, stage: Stage, slot: usize) {
         let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
         pass.set_pipeline(self.pipelines.pipeline(stage));
         let groups = self.data.bind_groups.as_ref().expect("made with the buffers");
@@ -687,6 +696,9 @@ impl World {
             Over::Pairs => pass.dispatch_workgroups_indirect(&self.data.dispatch, 0),
             Over::Manifolds => pass.dispatch_workgroups_indirect(&self.data.dispatch, 16),
             over => pass.dispatch_workgroups(self.workgroups(over), 1, 1),
+        }
+        if stage.flips_state() {
+            self.current = 1 - self.current;
         }
     }
 
@@ -719,21 +731,12 @@ impl World {
         slot: usize,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        if stage == Stage::Narrowphase {
-            // the pair scan wrote the dispatch's size into status[8..11]
-            encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12);
-        }
+        self.copy_dispatch_sizes(encoder, stage, true);
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(stage.name()), timestamp_writes: timestamps });
         self.dispatch(&mut pass, stage, slot);
         drop(pass);
-        if stage == Stage::ContactLists {
-            // the contact passes' dispatch, written into status[12..15]
-            encoder.copy_buffer_to_buffer(&self.data.status, 48, &self.data.dispatch, 16, 12);
-        }
-        if stage.flips_state() {
-            self.current = 1 - self.current;
-        }
+        self.copy_dispatch_sizes(encoder, stage, false);
     }
 
     /// Runs `stages` alone, in order, each as a step's first substep runs it,
