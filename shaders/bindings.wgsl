@@ -105,11 +105,14 @@ fn point_speed(s: BodyState, p: BodyProps) -> f32 {
 fn contact_end(i: u32) -> ContactEnd {
     if (i == GROUND) {
         let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-        return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), false,
+        let identity = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+        return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), identity, mat3x3<f32>(), mat3x3<f32>(), false,
                           params.ground_restitution, params.ground_friction, 0.0);
     }
     let s = state_in[i];
     let p = props[i];
-    return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, !is_fixed(p) && !asleep(s),
+    let r = quat_to_mat(s.rot);
+    return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
+                      world_inv_inertia(r, p.inv_inertia.xyz), !is_fixed(p) && !asleep(s),
                       p.restitution, p.friction, select(0.0, p.half_extents.x, p.shape == SHAPE_SPHERE));
 }

@@ -160,8 +160,10 @@ struct ManifoldSnaps {
 // flags (WOKEN_*), whether contacts can move it this step, how many of its
 // pairs have a manifold (contact_lists: its list then starts with their
 // contact references, see `contact_ref`), and its bounds: the half extents
-// of its world box grown by its reach (how far it may move this step, m).
-// The entry after the last body holds the totals. 48 bytes.
+// of its world box grown by its reach (how far it may move this step, m),
+// and how many of its manifolds are with an end that stays (contact_lists;
+// friction's split, see solve.wgsl). The entry after the last body holds
+// the totals. 64 bytes.
 struct PairMeta {
     owned: u32,
     total: u32,
@@ -173,6 +175,7 @@ struct PairMeta {
     contacts: u32,
     extent: vec3<f32>,
     reach: f32,
+    held: u32,
 }
 
 // pair_meta[i].woken bits, WOKEN_NOW and WOKEN_LAST (shared with Rust,
@@ -277,6 +280,30 @@ fn quat_add_rotation(q: vec4<f32>, dtheta: vec3<f32>) -> vec4<f32> {
     return normalize(q + 0.5 * quat_mul(vec4<f32>(dtheta, 0.0), q));
 }
 
+// The rotation matrix of unit quaternion q (columns: the body's axes).
+fn quat_to_mat(q: vec4<f32>) -> mat3x3<f32> {
+    let x2 = q.xyz * 2.0;
+    let xx = q.x * x2.x;
+    let yy = q.y * x2.y;
+    let zz = q.z * x2.z;
+    let xy = q.x * x2.y;
+    let xz = q.x * x2.z;
+    let yz = q.y * x2.z;
+    let wx = q.w * x2.x;
+    let wy = q.w * x2.y;
+    let wz = q.w * x2.z;
+    return mat3x3<f32>(vec3<f32>(1.0 - yy - zz, xy + wz, xz - wy), vec3<f32>(xy - wz, 1.0 - xx - zz, yz + wx),
+                       vec3<f32>(xz + wy, yz - wx, 1.0 - xx - yy));
+}
+
+// World-frame inverse inertia as a matrix, from the rotation's matrix r:
+// R diag(inv_i) R^T. Made once
+// for a body that many contacts push, it spares each push the two rotations
+// inv_inertia_world makes.
+fn world_inv_inertia(r: mat3x3<f32>, inv_i: vec3<f32>) -> mat3x3<f32> {
+    return mat3x3<f32>(r[0] * inv_i.x, r[1] * inv_i.y, r[2] * inv_i.z) * transpose(r);
+}
+
 // World-frame inverse inertia applied to v: R diag(inv_i) R^T v.
 fn inv_inertia_world(q: vec4<f32>, inv_i: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
     let local = quat_rotate(quat_conj(q), v);
@@ -302,6 +329,9 @@ struct ContactEnd {
     rot: vec4<f32>,
     prev_rot: vec4<f32>,
     inv_inertia: vec4<f32>, // xyz body frame (1/(kg m^2)); w = inverse mass (1/kg)
+    rot_m: mat3x3<f32>,       // rot as a matrix
+    turn_m: mat3x3<f32>,      // rot's matrix less prev_rot's: what the last turn moved a point by
+    inv_i_world: mat3x3<f32>, // the inverse inertia in world axes (world_inv_inertia)
     moves: bool,            // awake and not fixed: the contacts may move it
     restitution: f32,
     friction: f32,
@@ -316,7 +346,7 @@ struct ContactEnd {
 // read the ball as above the ground while it sank through it.
 fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
     if (e.radius > 0.0) {
-        return quat_rotate(quat_conj(e.rot), toward * e.radius);
+        return (toward * e.radius) * e.rot_m; // R^T (toward r)
     }
     return stored;
 }
@@ -328,7 +358,7 @@ fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
         return 0.0;
     }
     let rn = cross(r, dir);
-    return e.inv_inertia.w + dot(rn, inv_inertia_world(e.rot, e.inv_inertia.xyz, rn));
+    return e.inv_inertia.w + dot(rn, e.inv_i_world * rn);
 }
 
 // What a summed impulse-like vector j (through points at summed moments
@@ -338,7 +368,7 @@ fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, flags: u
     if (!e.moves) {
         return EndSnap(vec3<f32>(0.0), 0u, vec3<f32>(0.0), flags);
     }
-    return EndSnap(j * e.inv_inertia.w, count, inv_inertia_world(e.rot, e.inv_inertia.xyz, moment), flags);
+    return EndSnap(j * e.inv_inertia.w, count, e.inv_i_world * moment, flags);
 }
 
 // Restitution and friction of a contact: the larger restitution and the

@@ -246,7 +246,9 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
 // timing) into pair order: the pairs the body is in by the partner's walk,
 // by pair index, then the pairs it owns, in the order its walk found them.
 // The solve and restitution sum a body's manifolds in this order, the same
-// every run. The count goes to pair_meta's `contacts`. Invocation 0 also
+// every run. The count goes to pair_meta's `contacts`, and how many of them
+// are with an end that stays (the ground, a fixed or a sleeping body) to
+// its `held`. Invocation 0 also
 // writes the contact passes' indirect dispatch, over the manifolds the pool
 // holds (status[12..15]).
 @compute @workgroup_size(WORKGROUP)
@@ -277,6 +279,13 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         body_pairs[m] = r;
     }
     pair_meta[i].contacts = end - first;
+    var held = 0u;
+    for (var k = first; k < end; k = k + 1u) {
+        let r = body_pairs[k];
+        let partner = select(manifolds[r >> 1u].b, manifolds[r >> 1u].a, (r & 1u) != 0u);
+        held = held + u32(partner == GROUND || !contact_end(partner).moves);
+    }
+    pair_meta[i].held = held;
 }
 
 // Where contact reference r goes in its body's list: pairs the body does not

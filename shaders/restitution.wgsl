@@ -79,8 +79,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var q = 0u; q < count; q = q + 1u) {
         let pt = manifolds[k].points[q];
         manifolds[k].points[q].pushed = 0.0;
-        let ra = quat_rotate(ea.rot, end_point(ea, pt.local_a, n));
-        let rb = quat_rotate(eb.rot, end_point(eb, pt.local_b, -n));
+        let ra = ea.rot_m * end_point(ea, pt.local_a, n);
+        let rb = eb.rot_m * end_point(eb, pt.local_b, -n);
         // touching?
         if (dot((eb.pos + rb) - (ea.pos + ra), n) > CONTACT_SLOP) {
             continue;

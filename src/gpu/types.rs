@@ -171,7 +171,7 @@ pub struct ManifoldSnaps {
     pub b: EndSnap,
 }
 
-/// A body's pair bookkeeping (48 bytes); see `PairMeta` in common.wgsl.
+/// A body's pair bookkeeping (64 bytes); see `PairMeta` in common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct PairMeta {
@@ -190,6 +190,10 @@ pub struct PairMeta {
     pub extent: [f32; 3],
     /// How far it may move this step (m).
     pub reach: f32,
+    /// How many of its manifolds are with an end that stays (the ground, a
+    /// fixed or a sleeping body): friction's split (shaders/solve.wgsl).
+    pub held: u32,
+    pub _pad: [u32; 3],
 }
 
 /// One contact point as one body of its pair sees it (host only, from
