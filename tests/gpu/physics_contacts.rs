@@ -119,6 +119,42 @@ fn a_pyramid_of_ten_rows_stands() {
     assert!(moved < 0.05, "a box moved {moved} m");
 }
 
+/// A box wedged between fixed boxes, four under it and four pressing on it
+/// from above (1 mm), sent sideways at 0.3 m/s: friction stops it and it
+/// stays. Each of the eight manifolds undid its whole slide and the solve
+/// relaxed their sum by c_r, four times too far: it jittered sideways at
+/// up to 2.7 m/s in its third second (as a cube wedged between sleepers in
+/// a pile did, awake for good). Friction against ends that stay is now
+/// split among them (solve.wgsl's friction_split).
+#[test]
+fn a_box_wedged_between_fixed_boxes_comes_to_rest() {
+    let mut scene = scenes::stack(0);
+    scene.settings.sleeping = false;
+    let mut wedged = box_body([0.5; 3], [0.0, 1.0, 0.0]);
+    wedged.linear_velocity = [0.3, 0.0, 0.1];
+    scene.bodies.push(wedged);
+    for (x, z) in [(-0.25, -0.25), (-0.25, 0.25), (0.25, -0.25), (0.25, 0.25)] {
+        for y in [0.25, 1.749] {
+            let mut post = box_body([0.25; 3], [x, y, z]);
+            post.fixed = true;
+            scene.bodies.push(post);
+        }
+    }
+    let Some(mut w) = world(&scene) else { return };
+    w.step(120).unwrap();
+    let settled = v3(w.read_state().unwrap()[0].position);
+    let (mut fastest, mut wandered) = (0.0f32, 0.0f32);
+    for _ in 0..60 {
+        w.step(1).unwrap();
+        let s = w.read_state().unwrap()[0];
+        fastest = fastest.max(v3(s.linear_velocity).with_y(0.0).length());
+        wandered = wandered.max((v3(s.position) - settled).with_y(0.0).length());
+    }
+    eprintln!("wedged box, third second: fastest sideways {fastest} m/s, wandered {wandered} m");
+    assert!(fastest < 0.05, "the wedged box still moves sideways at {fastest} m/s");
+    assert!(wandered < 0.005, "the wedged box wandered {wandered} m");
+}
+
 /// Places every box as a person would: shifted up to 1 cm sideways and
 /// turned up to about 1 degree about the vertical, by a fixed pattern.
 fn imperfect(mut scene: Scene) -> Scene {
