@@ -21,7 +21,7 @@
 @group(0) @binding(10) var<storage, read_write> pairs: array<Pair>;             // pair capacity
 @group(0) @binding(11) var<storage, read_write> manifolds: array<ContactManifold>; // manifold capacity
 // what each manifold asks of its two bodies in a sweep (solve.wgsl, restitution.wgsl)
-@group(0) @binding(9) var<storage, read_write> snaps: array<ManifoldSnaps>;     // manifold capacity
+@group(0) @binding(9) var<storage, read_write> snaps: array<EndSnap>;           // 2 x manifold capacity
 @group(0) @binding(15) var<storage, read_write> pair_meta: array<PairMeta>;     // body_count + 1
 @group(0) @binding(16) var<storage, read_write> body_pairs: array<u32>;         // 2 x pair capacity
 // status[0]: candidate pairs wanted this step, status[1]: most in any step;
@@ -62,12 +62,10 @@ fn pool_slot(k: u32) -> u32 {
 
 // Helpers that read the bindings (common.wgsl binds nothing).
 
-// The snap manifold `r >> 1` asks of the body that holds reference r.
+// The snap manifold `r >> 1` asks of the body that holds reference r: at
+// r itself (a's at 2 x the slot, b's next), one load with no branch.
 fn snap_of(r: u32) -> EndSnap {
-    if ((r & 1u) != 0u) {
-        return snaps[r >> 1u].b;
-    }
-    return snaps[r >> 1u].a;
+    return snaps[r];
 }
 
 // Sleeping (settings.sleeping; the paper has none). A body that has been

@@ -216,7 +216,8 @@ fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let best_face_sep = max(a_sep, b_sep);
     var worst = best_face_sep;
     let face_s = select(s_b[best_face % 3u], t[best_face % 3u], best_face < 3u);
-    let face_axis = select(axes_b[best_face % 3u], axes_a[best_face % 3u], best_face < 3u);
+    let face_axis = column(mat3x3<f32>(select(axes_b[0], axes_a[0], best_face < 3u), select(axes_b[1], axes_a[1], best_face < 3u),
+                                       select(axes_b[2], axes_a[2], best_face < 3u)), best_face % 3u);
     let best_face_n = select(face_axis, -face_axis, face_s < 0.0);
 
     // edge axes a_i x b_j, in a's frame; near-parallel edges are left to

@@ -136,7 +136,9 @@ struct ContactManifold {
 // (restitution); `flags`: SNAP_PRESSED if a point has pushed in this
 // substep, and above SETTLE_SHIFT the share of the move and turn that
 // pushes out old overlap MAX_DEPENETRATION_SPEED held back, in
-// 1/SETTLE_ONE (solve only; see solve.wgsl). 32 bytes.
+// 1/SETTLE_ONE (solve only; see solve.wgsl). A manifold's two, a's then
+// b's, sit at 2 x its slot: a body reads its at its contact reference
+// (contact_ref). 32 bytes.
 struct EndSnap {
     dx: vec3<f32>,
     count: u32,
@@ -147,12 +149,6 @@ struct EndSnap {
 const SNAP_PRESSED: u32 = 1u;
 const SETTLE_SHIFT: u32 = 16u;
 const SETTLE_ONE: f32 = 65535.0;
-
-// Both ends' snaps of one manifold, at its index in the pool. 64 bytes.
-struct ManifoldSnaps {
-    a: EndSnap,
-    b: EndSnap,
-}
 
 // Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
 // how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of

@@ -11,7 +11,7 @@
 // velocity change its push made (mu |dv_n|, Coulomb's law per substep).
 // Every contact is measured on the velocities after the solve, once per
 // manifold (restitution_contacts, which writes what it asks of each body to
-// snaps[manifold] and empties its points' friction budgets); each body sums
+// its two EndSnaps in snaps and empties its points' friction budgets); each body sums
 // what its manifolds ask (restitution), the turns split among the contacts
 // that acted as in the solve.
 
@@ -115,7 +115,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
             acting = acting + 1u;
         }
     }
-    snaps[k] = ManifoldSnaps(end_snap(ea, -j, -moment_a, acting, 0u), end_snap(eb, j, moment_b, acting, 0u));
+    snaps[contact_ref(k, false)] = end_snap(ea, -j, -moment_a, acting, 0u);
+    snaps[contact_ref(k, true)] = end_snap(eb, j, moment_b, acting, 0u);
 }
 
 @compute @workgroup_size(WORKGROUP)

@@ -3,7 +3,7 @@
 // Contacts are relaxed Jacobi style. Every pose is read from state_in:
 // solve_contacts, one invocation per manifold of the pool, measures all of
 // a pair's points once and writes what they ask of each of its two bodies
-// (snaps[manifold]); solve, one invocation per body, sums what its
+// (its two EndSnaps in snaps); solve, one invocation per body, sums what its
 // manifolds ask, relaxes the sum by c_r (eq. 10) and writes only its own
 // slot of state_out. Joints are then closed in turn, Gauss-Seidel style,
 // by solve_joints (below). All of a body's snaps are
@@ -203,8 +203,8 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the share of the snap that settles (see solve)
     let settle = u32(round(clamp(old_depth / max(all_depth, 1e-30), 0.0, 1.0) * SETTLE_ONE));
     let flags = select(0u, SNAP_PRESSED, pressed != 0u) | (settle << SETTLE_SHIFT);
-    snaps[k] = ManifoldSnaps(end_snap(ea, -j, -moment_a * turns, touched, flags),
-                             end_snap(eb, j, moment_b * turns, touched, flags));
+    snaps[contact_ref(k, false)] = end_snap(ea, -j, -moment_a * turns, touched, flags);
+    snaps[contact_ref(k, true)] = end_snap(eb, j, moment_b * turns, touched, flags);
 }
 
 @compute @workgroup_size(WORKGROUP)

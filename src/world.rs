@@ -256,7 +256,7 @@ pub fn bytes_per_body() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
     let meta = std::mem::size_of::<PairMeta>() as u64;
     let pairs = PAIRS_PER_BODY * (std::mem::size_of::<Pair>() as u64 + 2 * 4) + meta;
-    let manifolds = MANIFOLDS_PER_BODY * (std::mem::size_of::<ContactManifold>() + std::mem::size_of::<ManifoldSnaps>()) as u64;
+    let manifolds = MANIFOLDS_PER_BODY * (std::mem::size_of::<ContactManifold>() + 2 * std::mem::size_of::<EndSnap>()) as u64;
     let grid = 4 + 2 * 8;
     let batch_start = state + meta;
     2 * state
@@ -354,7 +354,7 @@ impl World {
         let (pair_capacity, manifold_capacity) = pair_capacities(&gpu, count as u64);
         let pairs = storage("pairs", pair_capacity * std::mem::size_of::<Pair>() as u64);
         let manifolds = storage("manifolds", manifold_capacity * std::mem::size_of::<ContactManifold>() as u64);
-        let snaps = storage("manifolds/snaps", manifold_capacity * std::mem::size_of::<ManifoldSnaps>() as u64);
+        let snaps = storage("manifolds/snaps", manifold_capacity * 2 * std::mem::size_of::<EndSnap>() as u64);
         let meta_bytes = (count as u64 + 1) * std::mem::size_of::<PairMeta>() as u64;
         let pair_meta = storage("pairs/meta", meta_bytes);
         let state_bytes = (count * std::mem::size_of::<BodyState>()) as u64;
@@ -560,7 +560,7 @@ impl World {
         }
         if let Some(n) = manifolds {
             grow(&mut self.data.manifolds, "manifolds", n * std::mem::size_of::<ContactManifold>() as u64);
-            grow(&mut self.data.snaps, "manifolds/snaps", n * std::mem::size_of::<ManifoldSnaps>() as u64);
+            grow(&mut self.data.snaps, "manifolds/snaps", n * 2 * std::mem::size_of::<EndSnap>() as u64);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines.layout));

@@ -153,7 +153,8 @@ pub struct ContactManifold {
 }
 
 /// What a manifold asks of one of its bodies in a sweep (32 bytes); see
-/// `EndSnap` in common.wgsl.
+/// `EndSnap` in common.wgsl. A manifold's two sit at 2 x its slot (a's,
+/// then b's).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct EndSnap {
@@ -161,14 +162,6 @@ pub struct EndSnap {
     pub count: u32,
     pub dtheta: [f32; 3],
     pub flags: u32,
-}
-
-/// Both ends' snaps of one manifold (64 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct ManifoldSnaps {
-    pub a: EndSnap,
-    pub b: EndSnap,
 }
 
 /// A body's pair bookkeeping (64 bytes); see `PairMeta` in common.wgsl.
