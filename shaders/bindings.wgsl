@@ -100,6 +100,12 @@ fn point_speed(s: BodyState, p: BodyProps) -> f32 {
     return (length(s.disp) + spin * p.half_extents.w) / params.dt_prev;
 }
 
+// Whether the contacts may move body i: awake and not fixed (ContactEnd's
+// `moves`).
+fn contact_end_moves(i: u32) -> bool {
+    return !is_fixed(props[i]) && !asleep(state_in[i]);
+}
+
 fn contact_end(i: u32) -> ContactEnd {
     if (i == GROUND) {
         let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
@@ -111,6 +117,6 @@ fn contact_end(i: u32) -> ContactEnd {
     let p = props[i];
     let r = quat_to_mat(s.rot);
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
-                      world_inv_inertia(r, p.inv_inertia.xyz), !is_fixed(p) && !asleep(s),
+                      world_inv_inertia(r, p.inv_inertia.xyz), contact_end_moves(i),
                       p.restitution, p.friction, select(0.0, p.half_extents.x, p.shape == SHAPE_SPHERE));
 }

@@ -293,9 +293,8 @@ fn quat_to_mat(q: vec4<f32>) -> mat3x3<f32> {
 }
 
 // World-frame inverse inertia as a matrix, from the rotation's matrix r:
-// R diag(inv_i) R^T. Made once
-// for a body that many contacts push, it spares each push the two rotations
-// inv_inertia_world makes.
+// R diag(inv_i) R^T. Made once for an end of a manifold, it spares each of
+// the manifold's pushes the two rotations inv_inertia_world makes.
 fn world_inv_inertia(r: mat3x3<f32>, inv_i: vec3<f32>) -> mat3x3<f32> {
     return mat3x3<f32>(r[0] * inv_i.x, r[1] * inv_i.y, r[2] * inv_i.z) * transpose(r);
 }

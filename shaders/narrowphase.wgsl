@@ -248,9 +248,8 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
 // The solve and restitution sum a body's manifolds in this order, the same
 // every run. The count goes to pair_meta's `contacts`, and how many of them
 // are with an end that stays (the ground, a fixed or a sleeping body) to
-// its `held`. Invocation 0 also
-// writes the contact passes' indirect dispatch, over the manifolds the pool
-// holds (status[12..15]).
+// its `held`. Invocation 0 also writes the contact passes' indirect
+// dispatch, over the manifolds the pool holds (status[12..15]).
 @compute @workgroup_size(WORKGROUP)
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -283,7 +282,7 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var k = first; k < end; k = k + 1u) {
         let r = body_pairs[k];
         let partner = select(manifolds[r >> 1u].b, manifolds[r >> 1u].a, (r & 1u) != 0u);
-        held = held + u32(partner == GROUND || !contact_end(partner).moves);
+        held = held + u32(partner == GROUND || !contact_end_moves(partner));
     }
     pair_meta[i].held = held;
 }
