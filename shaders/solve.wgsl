@@ -17,13 +17,6 @@ struct Snap {
     dtheta: vec3<f32>,
 }
 
-// Add a push of lambda along dir at offset r: translation along dir, rotation
-// about r x dir, both weighted by the body's inverse mass and inertia.
-fn add_push(acc: ptr<function, Snap>, p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>, lambda: f32) {
-    (*acc).dx = (*acc).dx + dir * (p.inv_inertia.w * lambda);
-    (*acc).dtheta = (*acc).dtheta + inv_inertia_world(rot, p.inv_inertia.xyz, cross(r, dir)) * lambda;
-}
-
 // One manifold's points, on the poses of state_in. For each point, the
 // normal snap closes the depth, shared by the two bodies by their inverse
 // masses (w_a + w_b, where a body the contacts may not move counts 0).
