@@ -137,34 +137,6 @@ fn closest_on_edges(pa: vec3<f32>, da: vec3<f32>, la: f32, pb: vec3<f32>, db: ve
     *out_b = pb + db * t;
 }
 
-// The clipped polygon, in the reference face's plane (coordinates along its
-// two side axes), in two buffers that the four clips write in turn (the next
-// clip reads what the last wrote; no copying between them).
-var<private> poly_a: array<vec2<f32>, 8>;
-var<private> poly_b: array<vec2<f32>, 8>;
-
-// Sutherland-Hodgman: the part of polygon `src` (len points) with
-// dot(p, n) <= offset, into `dst`; returns its length.
-fn clip_poly(src: ptr<private, array<vec2<f32>, 8>>, len: u32, dst: ptr<private, array<vec2<f32>, 8>>,
-             n: vec2<f32>, offset: f32) -> u32 {
-    var out_len = 0u;
-    for (var i = 0u; i < len; i = i + 1u) {
-        let p = (*src)[i];
-        let q = (*src)[select(i + 1u, 0u, i + 1u == len)];
-        let dp = dot(p, n) - offset;
-        let dq = dot(q, n) - offset;
-        if (dp <= 0.0 && out_len < 8u) {
-            (*dst)[out_len] = p;
-            out_len = out_len + 1u;
-        }
-        if ((dp <= 0.0) != (dq <= 0.0) && out_len < 8u) {
-            (*dst)[out_len] = p + (q - p) * (dp / (dp - dq));
-            out_len = out_len + 1u;
-        }
-    }
-    return out_len;
-}
-
 // Column k of m.
 fn column(m: mat3x3<f32>, k: u32) -> vec3<f32> {
     return select(select(m[2], m[1], k == 1u), m[0], k == 0u);
@@ -319,104 +291,158 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let c = to_face * (inc_centre - ref_centre);
     let du = (to_face * eu).xy;
     let dv = (to_face * ev).xy;
-    poly_a[0] = c.xy + du + dv;
-    poly_a[1] = c.xy - du + dv;
-    poly_a[2] = c.xy - du - dv;
-    poly_a[3] = c.xy + du - dv;
-    // height of the incident face above the reference face at p:
-    // c.z + dot(slope, p - c.xy) (|nf.z| >= 1/sqrt(3): the most parallel axis)
+    // the incident face's corners, x and y four to a vector, and its edges
+    // from each corner to the next
+    let px = c.x + vec4<f32>(du.x, -du.x, -du.x, du.x) + vec4<f32>(dv.x, dv.x, -dv.x, -dv.x);
+    let py = c.y + vec4<f32>(du.y, -du.y, -du.y, du.y) + vec4<f32>(dv.y, dv.y, -dv.y, -dv.y);
+    let ex = px.yzwx - px;
+    let ey = py.yzwx - py;
+    // height of the incident face above the reference face at (x, y):
+    // c.z + slope . ((x, y) - c.xy) (|nf.z| >= 1/sqrt(3): the most parallel axis)
     let nf = to_face * inc_axis;
     let slope = -nf.xy / nf.z;
 
-    // clip against the four side planes of the reference face: the two
-    // faces along its first side axis, then along its second
+    // The corners of the incident face's part within the reference face
+    // (|x| <= half.x, |y| <= half.y), found without clipping in arrays
+    // (lavapipe keeps dynamically indexed arrays in memory), as twelve
+    // candidates in three groups of four: where each edge enters the
+    // reference face (its start when that lies on it) and where it leaves
+    // it before its end, from the part t0..t1 of the edge within both slabs
+    // (Liang-Barsky); then the reference face's corners strictly inside the
+    // incident face (on the inner side of its four edges, which the face's
+    // winding cross2(du, dv) tells).
     let half = vec2<f32>(ref_h[side_u], ref_h[side_v]);
-    var len = clip_poly(&poly_a, 4u, &poly_b, vec2<f32>(1.0, 0.0), half.x);
-    len = clip_poly(&poly_b, len, &poly_a, vec2<f32>(-1.0, 0.0), half.x);
-    len = clip_poly(&poly_a, len, &poly_b, vec2<f32>(0.0, 1.0), half.y);
-    len = clip_poly(&poly_b, len, &poly_a, vec2<f32>(0.0, -1.0), half.y);
+    let span_x = slab_span(px, ex, half.x);
+    let span_y = slab_span(py, ey, half.y);
+    let t0 = max(max(vec4<f32>(0.0), span_x.enter), span_y.enter);
+    let t1 = min(min(vec4<f32>(1.0), span_x.leave), span_y.leave);
+    let crosses = t0 <= t1;
+    let leaves = crosses & (t1 < vec4<f32>(1.0)) & (t1 > t0);
+    let winding = cross2(du, dv);
+    let rx = half.x * vec4<f32>(1.0, -1.0, -1.0, 1.0);
+    let ry = half.y * vec4<f32>(1.0, 1.0, -1.0, -1.0);
+    let inside = vec4<bool>(inside_face(rx.x, ry.x, px, py, ex, ey, winding), inside_face(rx.y, ry.y, px, py, ex, ey, winding),
+                            inside_face(rx.z, ry.z, px, py, ex, ey, winding), inside_face(rx.w, ry.w, px, py, ex, ey, winding));
+    let g0 = candidates(px + t0 * ex, py + t0 * ey, crosses, c, slope, margin);
+    let g1 = candidates(px + t1 * ex, py + t1 * ey, leaves, c, slope, margin);
+    let g2 = candidates(rx, ry, inside, c, slope, margin);
 
-    // the points within the margin of the reference face (`kept`), reduced
-    // to four: the deepest, the farthest from it, the largest triangle, the
-    // largest area added outside that triangle (the first of equals each)
+    // those within the margin of the reference face (`kept`), reduced to
+    // four: the deepest, the farthest from it, the largest triangle, the
+    // largest area added outside that triangle (the first of equals each,
+    // in candidate order; NONE when none is kept)
+    let c0 = best_candidate(-g0.z, -g1.z, -g2.z, g0, g1, g2);
+    let p0 = candidate_at(g0, g1, g2, c0).xy;
+    let c1 = best_candidate(distance2_to(g0, p0), distance2_to(g1, p0), distance2_to(g2, p0), g0, g1, g2);
+    let p1 = candidate_at(g0, g1, g2, c1).xy;
+    let c2 = best_candidate(abs(cross2_to(g0, p0, p1 - p0)), abs(cross2_to(g1, p0, p1 - p0)), abs(cross2_to(g2, p0, p1 - p0)),
+                            g0, g1, g2);
+    let p2 = candidate_at(g0, g1, g2, c2).xy;
+    let side = sign_of(cross2(p1 - p0, p2 - p0));
+    let c3 = best_candidate(area_added(g0, p0, p1, p2, side), area_added(g1, p0, p1, p2, side),
+                            area_added(g2, p0, p1, p2, side), g0, g1, g2);
+    // distinct choices only, in the order chosen, into slots 0..count
+    let chosen = vec4<u32>(c0, c1, c2, c3);
+    let fresh = vec4<bool>(c0 != NONE, c1 != c0, c2 != c0 && c2 != c1, c3 != c0 && c3 != c1 && c3 != c2);
+    var slots = vec4<u32>(NONE);
     var count = 0u;
-    var c0 = 8u;
-    var deepest = 3.4e38;
-    for (var k = 0u; k < len; k = k + 1u) {
-        let z = c.z + dot(slope, poly_a[k] - c.xy);
-        if (z <= margin) {
-            count = count + 1u;
-            if (z < deepest) {
-                deepest = z;
-                c0 = k;
-            }
-        }
+    for (var e = 0u; e < 4u; e = e + 1u) {
+        slots = select(slots, vec4<u32>(chosen[e]), vec4<bool>(fresh[e]) & (vec4<u32>(count) == vec4<u32>(0u, 1u, 2u, 3u)));
+        count = count + u32(fresh[e]);
     }
     m.normal = n;
-    if (count <= MAX_POINTS) {
-        for (var k = 0u; k < len; k = k + 1u) {
-            let z = c.z + dot(slope, poly_a[k] - c.xy);
-            if (z <= margin) {
-                face_point(&m, poly_a[k], z, ref_centre, su, sv, ref_n, flipped);
-            }
-        }
-        return m;
-    }
-    let p0 = poly_a[c0];
-    var c1 = c0;
-    var best = -1.0;
-    for (var k = 0u; k < len; k = k + 1u) {
-        let q = poly_a[k];
-        let dd = dot(q - p0, q - p0);
-        if (c.z + dot(slope, q - c.xy) <= margin && dd > best) {
-            best = dd;
-            c1 = k;
-        }
-    }
-    let p1 = poly_a[c1];
-    var c2 = c0;
-    best = -3.4e38;
-    for (var k = 0u; k < len; k = k + 1u) {
-        let q = poly_a[k];
-        let area = abs(cross2(p1 - p0, q - p0));
-        if (c.z + dot(slope, q - c.xy) <= margin && area > best) {
-            best = area;
-            c2 = k;
-        }
-    }
-    let p2 = poly_a[c2];
-    let side = sign_of(cross2(p1 - p0, p2 - p0));
-    var c3 = c0;
-    best = -3.4e38;
-    for (var k = 0u; k < len; k = k + 1u) {
-        let q = poly_a[k];
-        let added = max(max(-side * cross2(p1 - p0, q - p0), -side * cross2(p2 - p1, q - p1)), -side * cross2(p0 - p2, q - p2));
-        if (c.z + dot(slope, q - c.xy) <= margin && added > best) {
-            best = added;
-            c3 = k;
-        }
-    }
-    // distinct choices only, in the order chosen
-    for (var e = 0u; e < 4u; e = e + 1u) {
-        let k = select(select(select(c3, c2, e == 2u), c1, e == 1u), c0, e == 0u);
-        let seen = (e > 0u && k == c0) || (e > 1u && k == c1) || (e > 2u && k == c2);
-        if (!seen) {
-            let q = poly_a[k];
-            face_point(&m, q, c.z + dot(slope, q - c.xy), ref_centre, su, sv, ref_n, flipped);
-        }
+    m.count = count;
+    for (var q = 0u; q < MAX_POINTS; q = q + 1u) {
+        let p = candidate_at(g0, g1, g2, slots[q]);
+        let on_ref = ref_centre + su * p.x + sv * p.y;
+        let on_inc = on_ref + ref_n * p.z;
+        m.on_a[q] = select(on_ref, on_inc, flipped);
+        m.on_b[q] = select(on_inc, on_ref, flipped);
     }
     return m;
 }
 
-// Appends to m the face contact point at p in the reference face's plane,
-// z above it: the incident box's point and its projection on the face.
-fn face_point(m: ptr<function, Manifold>, p: vec2<f32>, z: f32, ref_centre: vec3<f32>, su: vec3<f32>,
-              sv: vec3<f32>, ref_n: vec3<f32>, flipped: bool) {
-    let on_ref = ref_centre + su * p.x + sv * p.y;
-    let on_inc = on_ref + ref_n * z;
-    (*m).on_a[(*m).count] = select(on_ref, on_inc, flipped);
-    (*m).on_b[(*m).count] = select(on_inc, on_ref, flipped);
-    (*m).count = (*m).count + 1u;
+// The parameters t at which edges p + t e (four at once, along one axis)
+// enter and leave the slab |x| <= h; an edge parallel to it spans
+// everything or nothing.
+struct SlabSpan {
+    enter: vec4<f32>,
+    leave: vec4<f32>,
+}
+
+fn slab_span(p: vec4<f32>, e: vec4<f32>, h: f32) -> SlabSpan {
+    let parallel = e == vec4<f32>(0.0);
+    let d = select(e, vec4<f32>(1.0), parallel);
+    let ta = (-h - p) / d;
+    let tb = (h - p) / d;
+    let within = abs(p) <= vec4<f32>(h);
+    let all_or_none = select(vec4<f32>(3.4e38), vec4<f32>(-3.4e38), within);
+    return SlabSpan(select(min(ta, tb), all_or_none, parallel), select(max(ta, tb), -all_or_none, parallel));
+}
+
+// Whether (x, y) lies strictly on the inner side of the four edges p + t e
+// of a face wound as `winding` says.
+fn inside_face(x: f32, y: f32, px: vec4<f32>, py: vec4<f32>, ex: vec4<f32>, ey: vec4<f32>, winding: f32) -> bool {
+    return all((ex * (y - py) - ey * (x - px)) * winding > vec4<f32>(0.0));
+}
+
+// Four candidate corners of a face contact's points in the reference
+// face's plane, their heights above it, and which are kept: corners of
+// the overlap within the margin.
+struct Candidates {
+    x: vec4<f32>,
+    y: vec4<f32>,
+    z: vec4<f32>,
+    kept: vec4<bool>,
+}
+
+fn candidates(x: vec4<f32>, y: vec4<f32>, corner: vec4<bool>, c: vec3<f32>, slope: vec2<f32>, margin: f32) -> Candidates {
+    let z = c.z + (slope.x * (x - c.x) + slope.y * (y - c.y));
+    return Candidates(x, y, z, corner & (z <= vec4<f32>(margin)));
+}
+
+// Candidate k of the twelve (x, y, z): group k / 4, lane k % 4.
+fn candidate_at(g0: Candidates, g1: Candidates, g2: Candidates, k: u32) -> vec3<f32> {
+    let lane = k % 4u;
+    let x = select(select(g2.x, g1.x, k < 8u), g0.x, k < 4u);
+    let y = select(select(g2.y, g1.y, k < 8u), g0.y, k < 4u);
+    let z = select(select(g2.z, g1.z, k < 8u), g0.z, k < 4u);
+    return vec3<f32>(x[lane], y[lane], z[lane]);
+}
+
+// The kept candidate of highest score (scores by group), the first of
+// equals; NONE when none is kept.
+fn best_candidate(s0: vec4<f32>, s1: vec4<f32>, s2: vec4<f32>, g0: Candidates, g1: Candidates, g2: Candidates) -> u32 {
+    var score = -3.4e38;
+    var best = NONE;
+    for (var k = 0u; k < 12u; k = k + 1u) {
+        let lane = k % 4u;
+        let s = select(select(s2, s1, k < 8u), s0, k < 4u)[lane];
+        let kept = select(select(g2.kept, g1.kept, k < 8u), g0.kept, k < 4u)[lane];
+        if (kept && s > score) {
+            score = s;
+            best = k;
+        }
+    }
+    return best;
+}
+
+// Squared distances of four candidates from p.
+fn distance2_to(g: Candidates, p: vec2<f32>) -> vec4<f32> {
+    let dx = g.x - p.x;
+    let dy = g.y - p.y;
+    return dx * dx + dy * dy;
+}
+
+// cross2(d, q - o) for four candidates q.
+fn cross2_to(g: Candidates, o: vec2<f32>, d: vec2<f32>) -> vec4<f32> {
+    return d.x * (g.y - o.y) - d.y * (g.x - o.x);
+}
+
+// Area (twice) that four candidates add outside the triangle p0 p1 p2 of
+// winding `side`: the most by which one lies outside any of its edges.
+fn area_added(g: Candidates, p0: vec2<f32>, p1: vec2<f32>, p2: vec2<f32>, side: f32) -> vec4<f32> {
+    return max(max(-side * cross2_to(g, p0, p1 - p0), -side * cross2_to(g, p1, p2 - p1)), -side * cross2_to(g, p2, p0 - p2));
 }
 
 // The manifold of a pair of which at least one is a sphere.

@@ -220,18 +220,16 @@ pub fn box_box(ca: Vec3, qa: Quat, ha: Vec3, cb: Vec3, qb: Quat, hb: Vec3, margi
     let to_face = Mat3::from_cols(su, sv, ref_n).transpose();
     let c = to_face * (inc_centre - ref_centre);
     let (du, dv) = ((to_face * eu).truncate(), (to_face * ev).truncate());
-    let mut poly = vec![c.truncate() + du + dv, c.truncate() - du + dv, c.truncate() - du - dv, c.truncate() + du - dv];
+    let corners = [c.truncate() + du + dv, c.truncate() - du + dv, c.truncate() - du - dv, c.truncate() + du - dv];
     let nf = to_face * inc_axis;
     let slope = -nf.truncate() / nf.z;
     let height = |p: Vec2| c.z + slope.dot(p - c.truncate());
 
-    // clip against the four side planes of the reference face
+    // the corners of the incident face's part within the reference face,
+    // those within the margin of it
     let half = Vec2::new(ref_h[side_u], ref_h[side_v]);
-    for (plane_n, offset) in [(Vec2::X, half.x), (-Vec2::X, half.x), (Vec2::Y, half.y), (-Vec2::Y, half.y)] {
-        poly = clip(&poly, plane_n, offset);
-    }
-    // keep points within the margin of the reference face
-    let points: Vec<(Vec2, f32)> = poly.into_iter().map(|p| (p, height(p))).filter(|&(_, z)| z <= margin).collect();
+    let points: Vec<(Vec2, f32)> =
+        overlap_corners(corners, half, du.perp_dot(dv)).into_iter().map(|p| (p, height(p))).filter(|&(_, z)| z <= margin).collect();
     if points.is_empty() {
         return None;
     }
@@ -250,22 +248,45 @@ pub fn box_box(ca: Vec3, qa: Quat, ha: Vec3, cb: Vec3, qb: Quat, hb: Vec3, margi
     Some(Manifold { normal: n, points })
 }
 
-/// Sutherland-Hodgman: the part of `poly` with dot(p, n) <= offset.
-fn clip(poly: &[Vec2], n: Vec2, offset: f32) -> Vec<Vec2> {
-    let mut out = Vec::with_capacity(8);
-    for i in 0..poly.len() {
-        let p = poly[i];
-        let q = poly[(i + 1) % poly.len()];
-        let dp = p.dot(n) - offset;
-        let dq = q.dot(n) - offset;
-        if dp <= 0.0 {
-            out.push(p);
+/// The corners of the part of a convex quadrilateral (`corners`, wound as
+/// the sign of `winding` says) within the rectangle |x| <= half.x,
+/// |y| <= half.y, in the GPU's candidate order: where each edge enters the
+/// rectangle (its start when that lies in it), then where each leaves it
+/// before its end (Liang-Barsky), then the rectangle's corners strictly
+/// inside the quadrilateral.
+fn overlap_corners(corners: [Vec2; 4], half: Vec2, winding: f32) -> Vec<Vec2> {
+    // the parameters at which p + t e enters and leaves the slab |x| <= h
+    let slab = |p: f32, e: f32, h: f32| {
+        if e == 0.0 {
+            if p.abs() <= h {
+                (f32::MIN, f32::MAX)
+            } else {
+                (f32::MAX, f32::MIN)
+            }
+        } else {
+            let (ta, tb) = ((-h - p) / e, (h - p) / e);
+            (ta.min(tb), ta.max(tb))
         }
-        if (dp <= 0.0) != (dq <= 0.0) {
-            out.push(p + (q - p) * (dp / (dp - dq)));
+    };
+    let mut enter = Vec::with_capacity(4);
+    let mut leave = Vec::with_capacity(4);
+    for k in 0..4 {
+        let p = corners[k];
+        let e = corners[(k + 1) % 4] - p;
+        let (x0, x1) = slab(p.x, e.x, half.x);
+        let (y0, y1) = slab(p.y, e.y, half.y);
+        let t0 = 0.0f32.max(x0).max(y0);
+        let t1 = 1.0f32.min(x1).min(y1);
+        if t0 <= t1 {
+            enter.push(p + t0 * e);
+            if t1 < 1.0 && t1 > t0 {
+                leave.push(p + t1 * e);
+            }
         }
     }
-    out
+    let inside = |r: Vec2| (0..4).all(|k| (corners[(k + 1) % 4] - corners[k]).perp_dot(r - corners[k]) * winding > 0.0);
+    let rect = [Vec2::new(half.x, half.y), Vec2::new(-half.x, half.y), Vec2::new(-half.x, -half.y), Vec2::new(half.x, -half.y)];
+    enter.into_iter().chain(leave).chain(rect.into_iter().filter(|&r| inside(r))).collect()
 }
 
 /// Closest points of two segments, each given by centre, unit direction and half length.
@@ -283,11 +304,10 @@ fn closest_on_edges(pa: Vec3, da: Vec3, la: f32, pb: Vec3, db: Vec3, lb: f32) ->
 }
 
 /// At most four points (in the reference face's plane, with their height
-/// above it) that keep the deepest one and span the most area.
+/// above it) that keep the deepest one and span the most area. Run on every
+/// face contact, as on the GPU: four or fewer points in general position
+/// all stay, a point that adds no area (between two others on a line) goes.
 fn reduce(points: Vec<(Vec2, f32)>) -> Vec<(Vec2, f32)> {
-    if points.len() <= MAX_POINTS {
-        return points;
-    }
     // 1: deepest (the first of equals, as every choice here)
     let mut chosen = [0usize; 4];
     for (i, p) in points.iter().enumerate() {
