@@ -70,6 +70,9 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let threshold = max(2.0 * length(params.gravity) * params.dt, RESTITUTION_THRESHOLD);
     let mu = combined_friction(ea, eb);
     let e = combined_restitution(ea, eb);
+    // against an end that stays, each contact cuts at most its share of the
+    // sliding (friction_split)
+    let split = select(1.0, friction_split(a, 1.0), !eb.moves) * select(1.0, friction_split(b, 1.0), !ea.moves);
     // summed over the points: the velocity change asked of b (a gets the
     // opposite), times the inverse masses later, and its moments
     var j = vec3<f32>(0.0);
@@ -96,7 +99,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
         let sliding = length(v_t);
         if (pt.pushed > 0.0 && sliding > 1e-6) {
             let t = v_t / sliding;
-            let cut = min(mu * pt.pushed / params.dt, sliding);
+            let cut = min(mu * pt.pushed / params.dt, sliding / split);
             impulse = impulse + t * (cut / (end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t)));
             acted = true;
         }

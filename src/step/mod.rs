@@ -230,10 +230,10 @@ impl Stage {
             Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Integrate => &[Params, Props, StateIn, Status, JointStart, PairMeta],
-            Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
+            Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status, PairMeta, JointStart],
             Stage::Solve => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs, JointStart],
             Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
-            Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status],
+            Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status, PairMeta],
             Stage::Restitution => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs],
         }
     }
