@@ -114,7 +114,7 @@ fn point_speed(s: BodyState, p: BodyProps) -> f32 {
 // Coulomb budget stays whole): there each such contact cut all the sliding
 // left, k times over, and a cube wedged between sleepers shook sideways
 // every other step at 0.13 m/s. Normal pushes split so too (solve.wgsl's
-// normal_split).
+// stay_splits).
 fn friction_split(i: u32, relaxation: f32) -> f32 {
     if (i == GROUND) {
         return 1.0;

@@ -9,7 +9,8 @@
 //   scan_add          buckets: add block offsets -> cell_start (the grid's
 //                     alone: pairs_write adds the pairs' own)
 //   grid_scatter      bodies:  sorted[cell_end - count--] = body
-//   grid_sort         buckets: sort each bucket's bodies by index (determinism)
+//   grid_sort         buckets: sort each bucket's bodies by the low x side of
+//                     their bounds, then index (the pair walks stop early)
 //
 // The scatter counts each bucket back down to 0, so the counts are 0 again
 // for the next step without a pass to clear them (a new buffer is zeroed).
@@ -226,8 +227,23 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     sorted[cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
 }
 
+// A grid body's key in its bucket: the low x side of its world box grown
+// by its reach (pair_meta's extent, written by grid_count).
+fn grid_key(i: u32) -> f32 {
+    return state_in[i].pos.x - pair_meta[i].extent.x;
+}
+
+// Whether body a comes before body b in their bucket: by key, then index.
+fn sorts_before(a: u32, b: u32) -> bool {
+    let ka = grid_key(a);
+    let kb = grid_key(b);
+    return ka < kb || (ka == kb && a < b);
+}
+
 // The scatter's order within a bucket depends on thread timing; sorting each
-// bucket by body index makes every later pass see the same order every run.
+// bucket (by key, then index) makes every later pass see the same order
+// every run, and lets a pair walk stop at the first body of a cell whose
+// box begins beyond the walker's reach along x (see pairs.wgsl).
 @compute @workgroup_size(WORKGROUP)
 fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
@@ -239,7 +255,7 @@ fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var k = start + 1u; k < end; k = k + 1u) {
         let v = sorted[k];
         var m = k;
-        while (m > start && sorted[m - 1u] > v) {
+        while (m > start && sorts_before(v, sorted[m - 1u])) {
             sorted[m] = sorted[m - 1u];
             m = m - 1u;
         }

@@ -154,13 +154,21 @@ fn visit(j: u32, pos_j: vec3<f32>) {
 }
 
 // Every body whose own cell is c (a bucket may also hold other cells) and
-// whose index is above `above` (the walker's own cell; NONE: every body).
+// whose index is above `above` (the walker's own cell; NONE: every body),
+// up to the first whose box begins beyond the walker's along x by more than
+// the margin: a bucket is sorted by where its boxes begin (grid_sort), so
+// no later one can be wanted either. (`wanted` decides, with its own
+// roundings; the stop keeps a slack of 1e-4 m and 1e-5 of the position.)
 fn visit_cell(c: vec3<i32>, above: u32) {
     let h = bucket_of(c);
     let end = cell_start[h + 1u];
+    let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
     for (var k = cell_start[h]; k < end; k = k + 1u) {
         let j = sorted[k];
         let pos_j = state_in[j].pos;
+        if (pos_j.x - pair_meta[j].extent.x > stop) {
+            break;
+        }
         if ((above == NONE || j > above) && all(cell_of(pos_j) == c)) {
             visit(j, pos_j);
         }

@@ -72,7 +72,13 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let e = combined_restitution(ea, eb);
     // against an end that stays, each contact cuts at most its share of the
     // sliding (friction_split)
-    let split = select(1.0, friction_split(a, 1.0), !eb.moves) * select(1.0, friction_split(b, 1.0), !ea.moves);
+    // (read only then; both ends never stay here)
+    var split = 1.0;
+    if (!eb.moves) {
+        split = friction_split(a, 1.0);
+    } else if (!ea.moves) {
+        split = friction_split(b, 1.0);
+    }
     // summed over the points: the velocity change asked of b (a gets the
     // opposite), times the inverse masses later, and its moments
     var j = vec3<f32>(0.0);

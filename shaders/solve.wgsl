@@ -66,20 +66,24 @@ const SETTLE_SPEED: f32 = 1.0;
 // 0.11 m/s for good, awake. With this and dynamic friction's split
 // (restitution.wgsl), 1000 piled cubes (seeds 7 to 14) are all at rest
 // after 15 s (no cube moves in the second after); before, six of eight
-// kept a cube moving at 0.06 to 0.11 m/s (this split alone: five of eight;
-// friction's alone: two of the four seeds tried). Built-in pyramids of 8 and 10 rows
-// now sleep whole; of 12 to 20 rows they still keep a box of a layer
-// between sleepers above and awake boxes below at 0.09-0.13 m/s (that
-// layer's pushes are not against ends that stay). Not for a jointed body:
-// its joints, closed after each sweep, pull it back against the weakened
-// pushes; ragdolls (8 to 12 on a pile) then kept a limb bobbing 14 cm for
-// seconds (0.16 m/s after 15 s), and without the split their fastest body
-// after 15 s stays below 0.09 m/s.
-fn normal_split(i: u32) -> f32 {
-    if (i == GROUND || joint_start[i + 1u] > joint_start[i]) {
-        return 1.0;
+// kept a cube moving at 0.06 to 0.11 m/s (this split alone: five of
+// eight; friction's alone: two of the four seeds tried). Built-in pyramids
+// of 8 and 10 rows now sleep whole; of 12 to 20 rows they still keep a box
+// of a layer between sleepers above and awake boxes below at 0.09-0.13
+// m/s (that layer's pushes are not against ends that stay). Not for a
+// jointed body: its joints, closed after each sweep, pull it back against
+// the weakened pushes; ragdolls (8 to 12 on a pile) then kept a limb
+// bobbing 14 cm for seconds (0.16 m/s after 15 s), and without the split
+// their fastest body after 15 s stays below 0.09 m/s.
+// Body i's splits (friction's, the normal pushes') in a manifold whose
+// other end moves or stays; 1 unless it stays (and read only then).
+fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
+    var splits = vec2<f32>(1.0);
+    if (!partner_moves && i != GROUND) {
+        let f = friction_split(i, params.relaxation);
+        splits = vec2<f32>(f, select(f, 1.0, joint_start[i + 1u] > joint_start[i]));
     }
-    return friction_split(i, params.relaxation);
+    return splits;
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -106,11 +110,13 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     eb.inv_inertia = eb.inv_inertia * shock_b;
     eb.inv_i_world = eb.inv_i_world * shock_b;
     let mu = combined_friction(ea, eb);
-    // friction against an end that stays is split (friction_split)
-    let split_a = select(1.0, friction_split(manifolds[k].a, params.relaxation), !eb.moves);
-    let split_b = select(1.0, friction_split(manifolds[k].b, params.relaxation), !ea.moves);
-    let normal_split_a = select(1.0, normal_split(manifolds[k].a), !eb.moves);
-    let normal_split_b = select(1.0, normal_split(manifolds[k].b), !ea.moves);
+    // pushes against an end that stays are split (stay_splits)
+    let splits_a = stay_splits(manifolds[k].a, eb.moves);
+    let splits_b = stay_splits(manifolds[k].b, ea.moves);
+    let split_a = splits_a.x;
+    let split_b = splits_b.x;
+    let normal_split_a = splits_a.y;
+    let normal_split_b = splits_b.y;
     // summed over the points, for a: normal and friction pushes (b gets the
     // opposite), their moments about each centre, the sums of 1 / w
     var normal_j = vec3<f32>(0.0);

@@ -220,7 +220,7 @@ impl Stage {
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
-            Stage::GridSort => &[Params, CellStart, Sorted],
+            Stage::GridSort => &[Params, StateIn, CellStart, Sorted, PairMeta],
             Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta],
             Stage::PairsWrite => {
                 &[Params, Props, StateIn, CellStart, BlockSums, Sorted, JointStart, JointRefs, PairMeta, BodyPairs]

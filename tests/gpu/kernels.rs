@@ -5,7 +5,7 @@
 use crate::common::world;
 use crate::common::Rng;
 use glam::{Quat, Vec3};
-use verlet::gpu::types::SCAN_SPAN;
+use verlet::gpu::types::{PairMeta, SCAN_SPAN};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
 use verlet::world::plan_grid;
@@ -21,8 +21,9 @@ fn grid_stages() -> Vec<Stage> {
 }
 
 /// The grid kernels sort the bodies as a CPU counting sort does: by hash
-/// bucket of their cell (grid.wgsl's bucket_of), by index within a bucket,
-/// the bodies kept out of the grid at the tail; cell_start holds the
+/// bucket of their cell (grid.wgsl's bucket_of), within a bucket by the low
+/// x side of their bounds (grid_key: centre less pair_meta's extent), then
+/// index, the bodies kept out of the grid at the tail; cell_start holds the
 /// buckets' prefix sums.
 #[test]
 fn the_grid_is_a_counting_sort_by_bucket() {
@@ -61,8 +62,15 @@ fn the_grid_is_a_counting_sort_by_bucket() {
             ^ (c.z as i32 as u32).wrapping_mul(83_492_791);
         h & (grid.hash_size - 1)
     };
+    // pair_meta's extent.x, read as words
+    let meta = w.read_words(Buffer::PairMeta).unwrap();
+    let (stride, extent) = (std::mem::size_of::<PairMeta>() / 4, std::mem::offset_of!(PairMeta, extent) / 4);
+    let key = |i: usize| states[i].pos[0] - f32::from_bits(meta[stride * i + extent]);
     let mut expected: Vec<u32> = (0..2500).collect();
-    expected.sort_by_key(|&i| (bucket(i as usize), i));
+    expected.sort_by(|&a, &b| {
+        let (a, b) = (a as usize, b as usize);
+        bucket(a).cmp(&bucket(b)).then(key(a).total_cmp(&key(b))).then(a.cmp(&b))
+    });
     expected.extend(&large);
     assert_eq!(&sorted[..2502], &expected[..], "sorted");
     let mut starts = vec![0u32; grid.hash_size as usize + 1];
