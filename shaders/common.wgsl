@@ -172,6 +172,7 @@ struct PairMeta {
     extent: vec3<f32>,
     reach: f32,
     held: u32,
+    normal_split: f32,
 }
 
 // pair_meta[i].woken bits, WOKEN_NOW and WOKEN_LAST (shared with Rust,

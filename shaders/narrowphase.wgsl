@@ -248,7 +248,8 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
 // The solve and restitution sum a body's manifolds in this order, the same
 // every run. The count goes to pair_meta's `contacts`, and how many of them
 // are with an end that stays (the ground, a fixed or a sleeping body) to
-// its `held`. Invocation 0 also writes the contact passes' indirect
+// its `held`, and from those and its shares of the pushes with partners
+// that move its `normal_split` (both for solve.wgsl's splits). Invocation 0 also writes the contact passes' indirect
 // dispatch, over the manifolds the pool holds (status[12..15]).
 @compute @workgroup_size(WORKGROUP)
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -279,12 +280,20 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     pair_meta[i].contacts = end - first;
     var held = 0u;
+    var movers = 0.0;
+    let w = props[i].inv_inertia.w;
     for (var k = first; k < end; k = k + 1u) {
         let r = body_pairs[k];
         let partner = select(manifolds[r >> 1u].b, manifolds[r >> 1u].a, (r & 1u) != 0u);
-        held = held + u32(partner == GROUND || !contact_end_moves(partner));
+        let stays = partner == GROUND || !contact_end_moves(partner);
+        held = held + u32(stays);
+        if (!stays) {
+            movers = movers + w / max(w + props[partner].inv_inertia.w, 1e-30);
+        }
     }
     pair_meta[i].held = held;
+    let jointed = joint_start[i + 1u] > joint_start[i];
+    pair_meta[i].normal_split = select(1.0, max(1.0, params.relaxation * (f32(held) + movers)), held > 0u && !jointed);
 }
 
 // Where contact reference r goes in its body's list: pairs the body does not

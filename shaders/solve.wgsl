@@ -60,28 +60,31 @@ const SHOCK_UP: f32 = 0.9;
 // for fifty boxes placed at one point (3.15 m/s at 1).
 const SETTLE_SPEED: f32 = 1.0;
 
-// Normal pushes against ends that stay, split as friction's (c_r k over
-// k such pushes is the same overshoot): a cube wedged between sleepers
-// (four below, three above) went up and down 0.6 mm every other step at
-// 0.11 m/s for good, awake. With this and dynamic friction's split
-// (restitution.wgsl), 1000 piled cubes (seeds 7 to 14) are all at rest
-// after 15 s (no cube moves in the second after); before, six of eight
-// kept a cube moving at 0.06 to 0.11 m/s (this split alone: five of
-// eight; friction's alone: two of the four seeds tried). Built-in pyramids
-// of 8 and 10 rows now sleep whole; of 12 to 20 rows they still keep a box
-// of a layer between sleepers above and awake boxes below at 0.09-0.13
-// m/s (that layer's pushes are not against ends that stay). Not for a
-// jointed body: its joints, closed after each sweep, pull it back against
-// the weakened pushes; ragdolls (8 to 12 on a pile) then kept a limb
-// bobbing 14 cm for seconds (0.16 m/s after 15 s), and without the split
-// their fastest body after 15 s stays below 0.09 m/s.
-// Body i's splits (friction's, the normal pushes') in a manifold whose
-// other end moves or stays; 1 unless it stays (and read only then).
+// Normal pushes against ends that stay are split too. A sweep moves a
+// body by c_r times the sum of its pushes, each its share of a depth: 1
+// against an end that stays, w_self / (w_self + w_partner) against one
+// that moves; past a gain of 2 the sweeps overshoot and the body flips
+// every sweep. A cube wedged between sleepers (four below, three above)
+// went up and down 0.6 mm every other step at 0.11 m/s for good, awake;
+// in pyramids of 12 to 20 rows a box under two sleepers and on two awake
+// boxes did so against them (the mode's gain there is 4: c_r 4 = 2, no
+// decay). A body held by k > 0 ends that stay counts its inverse mass
+// max(1, c_r s) times in its pushes against them, s its shares summed
+// (pair_meta's normal_split, from contact_lists). With this and dynamic
+// friction's split (restitution.wgsl), 1000 piled cubes (seeds 7 to 14)
+// are all at rest after 15 s, no cube moving in the second after (before:
+// six of eight kept a cube at 0.06 to 0.11 m/s), and the built-in pyramids
+// of 8 to 20 rows sleep whole. Splitting by k alone left the pyramids of
+// 12 rows and more; splitting every body's pushes by s, held or not, left
+// piles creeping up to 4 cm a second. Not for a jointed body: its joints,
+// closed after each sweep, pull it back against weakened pushes (ragdolls
+// on a pile kept a limb bobbing 14 cm for seconds).
+// Body i's splits in a manifold (friction's, the normal pushes'): 1 unless
+// the other end stays (and read only then).
 fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
     var splits = vec2<f32>(1.0);
     if (!partner_moves && i != GROUND) {
-        let f = friction_split(i, params.relaxation);
-        splits = vec2<f32>(f, select(f, 1.0, joint_start[i + 1u] > joint_start[i]));
+        splits = vec2<f32>(friction_split(i, params.relaxation), pair_meta[i].normal_split);
     }
     return splits;
 }

@@ -186,7 +186,10 @@ pub struct PairMeta {
     /// How many of its manifolds are with an end that stays (the ground, a
     /// fixed or a sleeping body): friction's split (shaders/solve.wgsl).
     pub held: u32,
-    pub _pad: [u32; 3],
+    /// How many times its normal pushes against ends that stay count its
+    /// inverse mass (contact_lists; shaders/solve.wgsl's stay_splits).
+    pub normal_split: f32,
+    pub _pad: [u32; 2],
 }
 
 /// One contact point as one body of its pair sees it (host only, from

@@ -227,10 +227,10 @@ impl Stage {
             }
             Stage::Narrowphase => &[Params, Props, StateIn, Pairs, Status, PairMeta],
             Stage::NarrowphaseGround => &[Params, Props, StateIn, Pairs, Status, PairMeta],
-            Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, PairMeta, BodyPairs],
+            Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Integrate => &[Params, Props, StateIn, Status, JointStart, PairMeta],
-            Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status, PairMeta, JointStart],
+            Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Solve => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs, JointStart],
             Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
             Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status, PairMeta],
