@@ -153,3 +153,19 @@ fn a_box_hanging_still_on_a_joint_sleeps() {
     assert!(v3(s.position).distance(glam::Vec3::new(0.0, 0.5, 0.0)) < 0.01, "{s:?}");
     assert!(s.asleep, "a jointed body at rest stayed awake");
 }
+
+/// A pyramid's boxes all fall asleep: a box pressed between sleepers above
+/// and awake boxes below used to flip up and down every sweep (0.5 mm,
+/// 0.09-0.13 m/s) and never sleep, in pyramids of 12 to 20 rows (the
+/// splits against ends that stay, shaders/solve.wgsl's stay_splits).
+#[test]
+fn every_box_of_a_fifteen_row_pyramid_falls_asleep() {
+    let scene = scenes::pyramid(15);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(900).unwrap(); // 15 s
+    let state = w.read_state().unwrap();
+    let awake: Vec<(usize, f32)> =
+        state.iter().enumerate().filter(|(_, b)| !b.asleep).map(|(i, b)| (i, v3(b.linear_velocity).length())).collect();
+    eprintln!("15-row pyramid after 15 s: awake (body, m/s) {awake:?}");
+    assert!(awake.is_empty(), "boxes still awake after 15 s: {awake:?}");
+}
