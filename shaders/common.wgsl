@@ -157,9 +157,10 @@ const SETTLE_ONE: f32 = 65535.0;
 // pairs have a manifold (contact_lists: its list then starts with their
 // contact references, see `contact_ref`), and its bounds: the half extents
 // of its world box grown by its reach (how far it may move this step, m),
-// and how many of its manifolds are with an end that stays (contact_lists;
-// friction's split, see solve.wgsl). The entry after the last body holds
-// the totals. 64 bytes.
+// how many of its manifolds are with an end that stays and what its normal
+// pushes against them count its inverse mass (contact_lists; the splits,
+// see bindings.wgsl's friction_split and solve.wgsl's stay_splits). The
+// entry after the last body holds the totals. 64 bytes.
 struct PairMeta {
     owned: u32,
     total: u32,

@@ -249,8 +249,9 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
 // every run. The count goes to pair_meta's `contacts`, and how many of them
 // are with an end that stays (the ground, a fixed or a sleeping body) to
 // its `held`, and from those and its shares of the pushes with partners
-// that move its `normal_split` (both for solve.wgsl's splits). Invocation 0 also writes the contact passes' indirect
-// dispatch, over the manifolds the pool holds (status[12..15]).
+// that move its `normal_split` (both for solve.wgsl's splits). Invocation
+// 0 also writes the contact passes' indirect dispatch, over the manifolds
+// the pool holds (status[12..15]).
 @compute @workgroup_size(WORKGROUP)
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;

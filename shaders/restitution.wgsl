@@ -71,8 +71,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let mu = combined_friction(ea, eb);
     let e = combined_restitution(ea, eb);
     // against an end that stays, each contact cuts at most its share of the
-    // sliding (friction_split)
-    // (read only then; both ends never stay here)
+    // sliding (friction_split; read only then, and never both ends stay here)
     var split = 1.0;
     if (!eb.moves) {
         split = friction_split(a, 1.0);

@@ -184,7 +184,7 @@ pub struct PairMeta {
     /// How far it may move this step (m).
     pub reach: f32,
     /// How many of its manifolds are with an end that stays (the ground, a
-    /// fixed or a sleeping body): friction's split (shaders/solve.wgsl).
+    /// fixed or a sleeping body): friction's split (shaders/bindings.wgsl).
     pub held: u32,
     /// How many times its normal pushes against ends that stay count its
     /// inverse mass (contact_lists; shaders/solve.wgsl's stay_splits).

@@ -70,7 +70,10 @@ fn shared_structs_match_member_by_member() {
     check_layout!(common, ContactPoint { local_a, pushed, local_b, _pad0 });
     check_layout!(common, ContactManifold { normal, count, a, b, clip_face, pair, points });
     check_layout!(common, EndSnap { dx, count, dtheta, flags });
-    check_layout!(common, PairMeta { owned, total, owned_start, list_start, cursor, woken, moves, contacts, extent, reach, held, normal_split });
+    check_layout!(
+        common,
+        PairMeta { owned, total, owned_start, list_start, cursor, woken, moves, contacts, extent, reach, held, normal_split }
+    );
 }
 
 /// The constants WGSL shares with Rust are written once, from the Rust values
