@@ -114,12 +114,9 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     eb.inv_i_world = eb.inv_i_world * shock_b;
     let mu = combined_friction(ea, eb);
     // pushes against an end that stays are split (stay_splits)
-    let splits_a = stay_splits(manifolds[k].a, eb.moves);
-    let splits_b = stay_splits(manifolds[k].b, ea.moves);
-    let split_a = splits_a.x;
-    let split_b = splits_b.x;
-    let normal_split_a = splits_a.y;
-    let normal_split_b = splits_b.y;
+    // (x: friction's, y: the normal pushes')
+    let split_a = stay_splits(manifolds[k].a, eb.moves);
+    let split_b = stay_splits(manifolds[k].b, ea.moves);
     // summed over the points, for a: normal and friction pushes (b gets the
     // opposite), their moments about each centre, the sums of 1 / w
     var normal_j = vec3<f32>(0.0);
@@ -167,7 +164,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
         var push = 0.0;
         var snapped = false;
         if (depth > 0.0) {
-            let w = end_inv_mass(ea, ra, n) * normal_split_a + end_inv_mass(eb, rb, n) * normal_split_b;
+            let w = end_inv_mass(ea, ra, n) * split_a.y + end_inv_mass(eb, rb, n) * split_b.y;
             let j = n * (depth / w); // pushes b along n, a along -n
             normal_j = normal_j + j;
             moment_a = moment_a + cross(ra, j);
@@ -183,7 +180,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
             let slide = length(slip_t);
             if (slide > 1e-9 && slide <= mu * (pt.pushed + push)) {
                 let t = slip_t / slide;
-                let w = end_inv_mass(ea, ra, t) * split_a + end_inv_mass(eb, rb, t) * split_b;
+                let w = end_inv_mass(ea, ra, t) * split_a.x + end_inv_mass(eb, rb, t) * split_b.x;
                 let j = t * (slide / w); // pulls b along t, a back along -t
                 friction_j = friction_j + j;
                 moment_a = moment_a + cross(ra, j);
@@ -202,11 +199,11 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     var pair_w_split = 0.0;
     if (ea.moves) {
         pair_w = pair_w + ea.inv_inertia.w;
-        pair_w_split = pair_w_split + ea.inv_inertia.w * normal_split_a;
+        pair_w_split = pair_w_split + ea.inv_inertia.w * split_a.y;
     }
     if (eb.moves) {
         pair_w = pair_w + eb.inv_inertia.w;
-        pair_w_split = pair_w_split + eb.inv_inertia.w * normal_split_b;
+        pair_w_split = pair_w_split + eb.inv_inertia.w * split_b.y;
     }
     let n_scale = min(1.0, 1.0 / max(pair_w_split * normal_inv_w, 1e-30));
     let f_scale = min(1.0, 1.0 / max(pair_w * friction_inv_w, 1e-30));
