@@ -171,9 +171,10 @@ struct PairMeta {
     moves: u32,
     contacts: u32,
     extent: vec3<f32>,
-    reach: f32,
+    bound: f32,
     held: u32,
     normal_split: f32,
+    reach: f32,
 }
 
 // pair_meta[i].woken bits, WOKEN_NOW and WOKEN_LAST (shared with Rust,

@@ -64,7 +64,7 @@ fn world_extent(i: u32) -> vec3<f32> {
 }
 
 // Counts body i into its bucket and writes what the pair list reads of it
-// (PairMeta's moves, extent and reach; see pairs.wgsl). Invocation 0 also
+// (PairMeta's moves, extent, bound and reach; see pairs.wgsl). Invocation 0 also
 // empties the manifold pool's counters (the step's first pass).
 @compute @workgroup_size(WORKGROUP)
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -83,6 +83,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
     pair_meta[i].reach = reach;
     pair_meta[i].extent = world_extent(i) + vec3<f32>(reach);
+    pair_meta[i].bound = props[i].half_extents.w + reach;
     if (!in_grid(i)) {
         return;
     }

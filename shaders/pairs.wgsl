@@ -40,9 +40,12 @@
 const CONTACT_MARGIN: f32 = 0.02;
 
 // Bodies joined by a joint do not collide: the joint holds them together
-// where their shapes meet.
-fn joined(i: u32, j: u32) -> bool {
-    for (var k = joint_start[i]; k < joint_start[i + 1u]; k = k + 1u) {
+// where their shapes meet. Whether the walker is joined to body j: one of
+// its own joint ends (read once, in `walk`) has j for partner. Reading the
+// lower index's ends instead made every candidate load two joint starts:
+// a fifth of pairs_count in a pile with no joints at all.
+fn joined_to_walker(j: u32) -> bool {
+    for (var k = walker.joints.x; k < walker.joints.y; k = k + 1u) {
         if (joint_refs[k].partner == j) {
             return true;
         }
@@ -83,14 +86,12 @@ fn wanted(j: u32, pos_j: vec3<f32>) -> bool {
         return false;
     }
     let d = walker.pos - pos_j;
-    let reach = walker.reach + pair_meta[j].reach;
-    let spheres = walker.radius + props[j].half_extents.w + reach + CONTACT_MARGIN;
+    let spheres = walker.bound + pair_meta[j].bound + CONTACT_MARGIN;
     if (dot(d, d) > spheres * spheres) {
         return false;
     }
     let apart = abs(d) - walker.extent - pair_meta[j].extent;
-    let i = walker.index;
-    return all(apart <= vec3<f32>(CONTACT_MARGIN)) && !joined(min(i, j), max(i, j));
+    return all(apart <= vec3<f32>(CONTACT_MARGIN)) && !joined_to_walker(j);
 }
 
 // Whether body i is near enough the ground for a ground pair.
@@ -99,14 +100,15 @@ fn wants_ground(i: u32) -> bool {
         && state_in[i].pos.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
 }
 
-// The walking body, read once: its index, centre, bounds and whether it moves.
+// The walking body, read once: its index, centre, bounds, whether it moves
+// and where its joint ends lie in joint_refs (start, end).
 struct Walker {
     index: u32,
     pos: vec3<f32>,
     extent: vec3<f32>,
-    reach: f32,
-    radius: f32,
+    bound: f32,
     moves: bool,
+    joints: vec2<u32>,
 }
 
 // The walk's state: who walks, whether it writes (pairs_write) or counts
@@ -178,8 +180,7 @@ fn visit_cell(c: vec3<i32>, above: u32) {
 // The ground, then (for a body in the grid) its own cell and the 13 cells
 // ahead of it, then the large bodies it owns pairs with.
 fn walk(i: u32) {
-    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].reach, props[i].half_extents.w,
-                    pair_meta[i].moves != 0u);
+    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].bound, pair_meta[i].moves != 0u, vec2<u32>(joint_start[i], joint_start[i + 1u]));
     owned = 0u;
     if (wants_ground(i)) {
         if (writing) {

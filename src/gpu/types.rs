@@ -181,15 +181,18 @@ pub struct PairMeta {
     pub contacts: u32,
     /// Half extents of its world box grown by its reach (m).
     pub extent: [f32; 3],
-    /// How far it may move this step (m).
-    pub reach: f32,
+    /// Its bounding radius grown by its reach (m); beside `extent`, so the
+    /// pair walk reads both bounds of a candidate at once.
+    pub bound: f32,
     /// How many of its manifolds are with an end that stays (the ground, a
     /// fixed or a sleeping body): friction's split (shaders/bindings.wgsl).
     pub held: u32,
     /// How many times its normal pushes against ends that stay count its
     /// inverse mass (contact_lists; shaders/solve.wgsl's stay_splits).
     pub normal_split: f32,
-    pub _pad: [u32; 2],
+    /// How far it may move this step (m).
+    pub reach: f32,
+    pub _pad: u32,
 }
 
 /// One contact point as one body of its pair sees it (host only, from

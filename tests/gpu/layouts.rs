@@ -72,7 +72,21 @@ fn shared_structs_match_member_by_member() {
     check_layout!(common, EndSnap { dx, count, dtheta, flags });
     check_layout!(
         common,
-        PairMeta { owned, total, owned_start, list_start, cursor, woken, moves, contacts, extent, reach, held, normal_split }
+        PairMeta {
+            owned,
+            total,
+            owned_start,
+            list_start,
+            cursor,
+            woken,
+            moves,
+            contacts,
+            extent,
+            bound,
+            held,
+            normal_split,
+            reach
+        }
     );
 }
 
