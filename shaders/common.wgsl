@@ -134,9 +134,10 @@ struct ContactManifold {
 // restitution) and a turn (radians, or rad/s), world axes; `count`: 1 if
 // the manifold snapped the body (solve) or the points that acted
 // (restitution); `flags`: SNAP_PRESSED if a point has pushed in this
-// substep, and above SETTLE_SHIFT the share of the move and turn that
-// pushes out old overlap MAX_DEPENETRATION_SPEED held back, in
-// 1/SETTLE_ONE (solve only; see solve.wgsl). A manifold's two, a's then
+// substep, above SETTLE_SHIFT the share of the move and turn that pushes
+// out old overlap deeper than SETTLE_SPEED allows, in 1/SETTLE_ONE, and
+// above SUPPORT_SHIFT (15 bits) the share of the move that pushes out
+// shallower old overlap, in 1/SUPPORT_ONE (solve only; see solve.wgsl). A manifold's two, a's then
 // b's, sit at 2 x its slot: a body reads its at its contact reference
 // (contact_ref). 32 bytes.
 struct EndSnap {
@@ -149,6 +150,9 @@ struct EndSnap {
 const SNAP_PRESSED: u32 = 1u;
 const SETTLE_SHIFT: u32 = 16u;
 const SETTLE_ONE: f32 = 65535.0;
+const SUPPORT_SHIFT: u32 = 1u;
+const SUPPORT_MASK: u32 = 0x7fffu;
+const SUPPORT_ONE: f32 = 32767.0;
 
 // Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
 // how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of
