@@ -137,9 +137,9 @@ struct ContactManifold {
 // substep, above SETTLE_SHIFT the share of the move and turn that pushes
 // out old overlap deeper than SETTLE_SPEED allows, in 1/SETTLE_ONE, and
 // above SUPPORT_SHIFT (15 bits) the share of the move that pushes out
-// shallower old overlap, in 1/SUPPORT_ONE (solve only; see solve.wgsl). A manifold's two, a's then
-// b's, sit at 2 x its slot: a body reads its at its contact reference
-// (contact_ref). 32 bytes.
+// shallower old overlap, in 1/SUPPORT_ONE (solve only; see solve.wgsl). A
+// manifold's two, a's then b's, sit at 2 x its slot: a body reads its at
+// its contact reference (contact_ref). 32 bytes.
 struct EndSnap {
     dx: vec3<f32>,
     count: u32,

@@ -64,8 +64,8 @@ fn world_extent(i: u32) -> vec3<f32> {
 }
 
 // Counts body i into its bucket and writes what the pair list reads of it
-// (PairMeta's moves, extent, bound and reach; see pairs.wgsl). Invocation 0 also
-// empties the manifold pool's counters (the step's first pass).
+// (PairMeta's moves, extent, bound and reach; see pairs.wgsl). Invocation 0
+// also empties the manifold pool's counters (the step's first pass).
 @compute @workgroup_size(WORKGROUP)
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;

@@ -180,7 +180,8 @@ fn visit_cell(c: vec3<i32>, above: u32) {
 // The ground, then (for a body in the grid) its own cell and the 13 cells
 // ahead of it, then the large bodies it owns pairs with.
 fn walk(i: u32) {
-    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].bound, pair_meta[i].moves != 0u, vec2<u32>(joint_start[i], joint_start[i + 1u]));
+    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].bound, pair_meta[i].moves != 0u,
+                    vec2<u32>(joint_start[i], joint_start[i + 1u]));
     owned = 0u;
     if (wants_ground(i)) {
         if (writing) {
