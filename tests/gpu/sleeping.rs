@@ -169,3 +169,29 @@ fn every_box_of_a_fifteen_row_pyramid_falls_asleep() {
     eprintln!("15-row pyramid after 15 s: awake (body, m/s) {awake:?}");
     assert!(awake.is_empty(), "boxes still awake after 15 s: {awake:?}");
 }
+
+/// A tall pyramid that fell asleep stays put when a poke wakes it: every
+/// body wakes at rest, and the sweeps' lag lets the stack sink into itself
+/// again before support reaches its top. Pushed out as velocity, that
+/// overlap threw the top box of a 30-row pyramid 6 cm up (solve.wgsl's
+/// SUPPORT_SPEED caps it now: 0.3 cm).
+#[test]
+fn a_slept_thirty_row_pyramid_woken_by_a_poke_stays_put() {
+    let scene = scenes::pyramid(30);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(900).unwrap(); // 15 s
+    let before = w.read_state().unwrap();
+    assert!(before.iter().all(|b| b.asleep), "the pyramid did not fall asleep in 15 s");
+    w.apply_impulse(0, [0.0, 0.0, 0.001], None).unwrap();
+    let top = before.len() - 1;
+    let mut rose = 0.0f32;
+    for _ in 0..60 {
+        w.step(1).unwrap();
+        rose = rose.max(w.read_state().unwrap()[top].position[1] - before[top].position[1]);
+    }
+    let after = w.read_state().unwrap();
+    let moved = before.iter().zip(&after).map(|(a, b)| v3(a.position).distance(v3(b.position))).fold(0.0, f32::max);
+    eprintln!("slept 30-row pyramid poked: top box rose {rose} m, largest move in the next second {moved} m");
+    assert!(rose < 0.01, "the top box jumped {rose} m");
+    assert!(moved < 0.02, "a box moved {moved} m");
+}
