@@ -122,6 +122,13 @@ fn friction_split(i: u32, relaxation: f32) -> f32 {
     return max(1.0, relaxation * f32(pair_meta[i].held));
 }
 
+// Whether body i has a joint: its contacts then neither split their normal
+// pushes against ends that stay (contact_lists) nor settle or cap their
+// support (solve), as its joints pull it back against weakened pushes.
+fn is_jointed(i: u32) -> bool {
+    return joint_start[i + 1u] > joint_start[i];
+}
+
 // Whether the contacts may move body i: awake and not fixed (ContactEnd's
 // `moves`).
 fn contact_end_moves(i: u32) -> bool {

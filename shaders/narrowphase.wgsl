@@ -293,7 +293,7 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     pair_meta[i].held = held;
-    let jointed = joint_start[i + 1u] > joint_start[i];
+    let jointed = is_jointed(i);
     pair_meta[i].normal_split = select(1.0, max(1.0, params.relaxation * (f32(held) + movers)), held > 0u && !jointed);
 }
 

@@ -273,7 +273,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the parts that push out shallower old overlap (SUPPORT_SPEED), apart
     // (not for a jointed body either)
     var support_dx = vec3<f32>(0.0);
-    let jointed = joint_start[i + 1u] > joint_start[i];
+    let jointed = is_jointed(i);
     // the body's manifolds in pair order (contact_lists)
     for (var e = first; e < end; e = e + 1u) {
         let snap = snap_of(body_pairs[e]);
