@@ -93,7 +93,9 @@ fn box_sphere(cb: vec3<f32>, rot: vec4<f32>, h: vec3<f32>, cs: vec3<f32>, r: f32
 fn flip_manifold(m_in: Manifold) -> Manifold {
     var m = m_in;
     m.normal = -m_in.normal;
-    for (var k = 0u; k < m_in.count; k = k + 1u) {
+    // every point, used or not: a loop of fixed length indexes its arrays
+    // with constants once unrolled
+    for (var k = 0u; k < MAX_POINTS; k = k + 1u) {
         m.on_a[k] = m_in.on_b[k];
         m.on_b[k] = m_in.on_a[k];
     }
@@ -140,6 +142,11 @@ fn closest_on_edges(pa: vec3<f32>, da: vec3<f32>, la: f32, pb: vec3<f32>, db: ve
 // Column k of m.
 fn column(m: mat3x3<f32>, k: u32) -> vec3<f32> {
     return select(select(m[2], m[1], k == 1u), m[0], k == 0u);
+}
+
+// Component k of v.
+fn component(v: vec3<f32>, k: u32) -> f32 {
+    return select(select(v.z, v.y, k == 1u), v.x, k == 0u);
 }
 
 // z x of two vectors in a plane (twice the signed area of their triangle).
@@ -224,25 +231,29 @@ fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
 // The one point of an edge-edge contact along `axis` (an AXIS_EDGE).
 fn box_box_edge(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, axis: BoxAxis) -> Manifold {
     var m = empty_manifold();
-    let axes_a = box_axes(qa);
-    let axes_b = box_axes(qb);
+    let ma = mat3x3<f32>(quat_rotate(qa, vec3<f32>(1.0, 0.0, 0.0)), quat_rotate(qa, vec3<f32>(0.0, 1.0, 0.0)),
+                         quat_rotate(qa, vec3<f32>(0.0, 0.0, 1.0)));
+    let mb = mat3x3<f32>(quat_rotate(qb, vec3<f32>(1.0, 0.0, 0.0)), quat_rotate(qb, vec3<f32>(0.0, 1.0, 0.0)),
+                         quat_rotate(qb, vec3<f32>(0.0, 0.0, 1.0)));
     let n = axis.normal;
     let edge_i = axis.edge_i;
     let edge_j = axis.edge_j;
-    // the edge of a farthest along n, the edge of b farthest along -n
+    // the edge of a farthest along n, the edge of b farthest along -n (the
+    // axes picked by select, not by an index: an array indexed by a value
+    // that differs per lane is slow to run and to compile on lavapipe)
     var pa = ca;
     var pb = cb;
     for (var k = 0u; k < 3u; k = k + 1u) {
         if (k != edge_i) {
-            pa = pa + axes_a[k] * (ha[k] * sign_of(dot(axes_a[k], n)));
+            pa = pa + ma[k] * (ha[k] * sign_of(dot(ma[k], n)));
         }
         if (k != edge_j) {
-            pb = pb - axes_b[k] * (hb[k] * sign_of(dot(axes_b[k], n)));
+            pb = pb - mb[k] * (hb[k] * sign_of(dot(mb[k], n)));
         }
     }
     var on_a: vec3<f32>;
     var on_b: vec3<f32>;
-    closest_on_edges(pa, axes_a[edge_i], ha[edge_i], pb, axes_b[edge_j], hb[edge_j], &on_a, &on_b);
+    closest_on_edges(pa, column(ma, edge_i), component(ha, edge_i), pb, column(mb, edge_j), component(hb, edge_j), &on_a, &on_b);
     m.normal = n;
     m.count = 1u;
     m.on_a[0] = on_a;
@@ -445,13 +456,23 @@ fn area_added(g: Candidates, p0: vec2<f32>, p1: vec2<f32>, p2: vec2<f32>, side: 
     return max(max(-side * cross2_to(g, p0, p1 - p0), -side * cross2_to(g, p1, p2 - p1)), -side * cross2_to(g, p2, p0 - p2));
 }
 
-// The manifold of a pair of which at least one is a sphere.
+// The manifold of a pair of which at least one is a sphere. A box and a
+// sphere are measured box first, in one call for either order (one copy of
+// box_sphere in the kernel: lavapipe's compile time grows steeply with a
+// kernel's size), and flipped back when the sphere came first.
 fn collide_with_sphere(a: Shape, b: Shape, margin: f32) -> Manifold {
     if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_SPHERE) {
         return sphere_sphere(a.centre, a.half.x, b.centre, b.half.x, margin);
     }
-    if (a.kind == SHAPE_BOX) {
-        return box_sphere(a.centre, a.rot, a.half, b.centre, b.half.x, margin);
+    let flip = a.kind != SHAPE_BOX;
+    let box_centre = select(a.centre, b.centre, flip);
+    let box_rot = select(a.rot, b.rot, flip);
+    let box_half = select(a.half, b.half, flip);
+    let ball_centre = select(b.centre, a.centre, flip);
+    let ball_radius = select(b.half.x, a.half.x, flip);
+    let m = box_sphere(box_centre, box_rot, box_half, ball_centre, ball_radius, margin);
+    if (flip) {
+        return flip_manifold(m);
     }
-    return flip_manifold(box_sphere(b.centre, b.rot, b.half, a.centre, a.half.x, margin));
+    return m;
 }

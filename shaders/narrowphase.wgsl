@@ -61,13 +61,19 @@ fn ground_manifold(i: u32, margin: f32) -> Manifold {
             chosen = chosen | (1u << best);
         }
     }
+    // in corner order; each point's place picked by comparison, not by
+    // indexing with the count (an array indexed by a value that differs per
+    // lane is slow to run and to compile on lavapipe)
     for (var k = 0u; k < 8u; k = k + 1u) {
-        if ((chosen & (1u << k)) != 0u) {
-            let w = s.pos + quat_rotate(s.rot, corner(k, p.half_extents.xyz));
-            m.on_a[m.count] = w;
-            m.on_b[m.count] = vec3<f32>(w.x, ground, w.z);
-            m.count = m.count + 1u;
+        let w = s.pos + quat_rotate(s.rot, corner(k, p.half_extents.xyz));
+        let on_ground = vec3<f32>(w.x, ground, w.z);
+        let picked = (chosen & (1u << k)) != 0u;
+        for (var q = 0u; q < MAX_POINTS; q = q + 1u) {
+            let here = picked && m.count == q;
+            m.on_a[q] = select(m.on_a[q], w, here);
+            m.on_b[q] = select(m.on_b[q], on_ground, here);
         }
+        m.count = m.count + u32(picked);
     }
     return m;
 }
@@ -159,40 +165,48 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pr = pairs[p];
-    var slot = NONE;
     // ground pairs: narrowphase_ground
-    if (pr.b != GROUND) {
-        let a = shape_of(pr.a);
-        let b = shape_of(pr.b);
-        let margin = pair_margin(pr.a, pr.b);
-        if (a.kind == SHAPE_BOX && b.kind == SHAPE_BOX) {
-            // the separating axis here; a face contact's clipping, the
-            // costly part, in narrowphase_clip over the face manifolds only
-            let axis = box_box_axis(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
-            if (axis.kind != AXIS_APART) {
-                slot = new_manifold(pr.a, pr.b, axis.kind == AXIS_FACE);
-            }
-            if (slot != NONE && axis.kind == AXIS_EDGE) {
-                store_manifold(slot, pr.a, pr.b, p, box_box_edge(a.centre, a.rot, a.half, b.centre, b.rot, b.half, axis));
-            } else if (slot != NONE) {
-                // pending: what narrowphase_clip needs (the points follow)
-                manifolds[slot].normal = axis.normal;
-                manifolds[slot].count = 0u;
-                manifolds[slot].a = pr.a;
-                manifolds[slot].b = pr.b;
-                manifolds[slot].clip_face = axis.face;
-                manifolds[slot].pair = p;
-            }
-        } else {
-            let m = collide_with_sphere(a, b, margin);
-            if (m.count > 0u) {
-                slot = new_manifold(pr.a, pr.b, false);
-                if (slot != NONE) {
-                    store_manifold(slot, pr.a, pr.b, p, m);
-                }
-            }
-        }
+    if (pr.b == GROUND) {
+        return;
     }
+    let a = shape_of(pr.a);
+    let b = shape_of(pr.b);
+    let margin = pair_margin(pr.a, pr.b);
+    // Two boxes get their separating axis here; a face contact's clipping,
+    // the costly part, waits for narrowphase_clip over the face manifolds
+    // only. Each step below has one call site, so the kernel holds one copy
+    // of it (lavapipe's compile time grows steeply with a kernel's size).
+    let boxes = a.kind == SHAPE_BOX && b.kind == SHAPE_BOX;
+    var axis = BoxAxis();
+    var m = empty_manifold();
+    if (boxes) {
+        axis = box_box_axis(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
+    } else {
+        m = collide_with_sphere(a, b, margin);
+    }
+    let touches = select(m.count > 0u, axis.kind != AXIS_APART, boxes);
+    let to_clip = boxes && axis.kind == AXIS_FACE;
+    if (!touches) {
+        return;
+    }
+    let slot = new_manifold(pr.a, pr.b, to_clip);
+    if (slot == NONE) {
+        return;
+    }
+    if (to_clip) {
+        // pending: what narrowphase_clip needs (the points follow)
+        manifolds[slot].normal = axis.normal;
+        manifolds[slot].count = 0u;
+        manifolds[slot].a = pr.a;
+        manifolds[slot].b = pr.b;
+        manifolds[slot].clip_face = axis.face;
+        manifolds[slot].pair = p;
+        return;
+    }
+    if (boxes) {
+        m = box_box_edge(a.centre, a.rot, a.half, b.centre, b.rot, b.half, axis);
+    }
+    store_manifold(slot, pr.a, pr.b, p, m);
 }
 
 // Pass "narrowphase_ground", after the narrowphase, one invocation per
