@@ -177,6 +177,23 @@ fn visit_cell(c: vec3<i32>, above: u32) {
     }
 }
 
+// The n-th cell a walk visits, as an offset from the walker's own (n = 0):
+// the 9 cells at +x (y, then z, from -1 to 1), the 3 at the same x and +y
+// (z from -1 to 1), the one at the same x and y and +z.
+fn cell_ahead(n: u32) -> vec3<i32> {
+    let m = i32(n) - 1;
+    if (n == 0u) {
+        return vec3<i32>(0);
+    }
+    if (n <= 9u) {
+        return vec3<i32>(1, m / 3 - 1, m % 3 - 1);
+    }
+    if (n <= 12u) {
+        return vec3<i32>(0, 1, m - 10);
+    }
+    return vec3<i32>(0, 0, 1);
+}
+
 // The ground, then (for a body in the grid) its own cell and the 13 cells
 // ahead of it, then the large bodies it owns pairs with.
 fn walk(i: u32) {
@@ -194,16 +211,11 @@ fn walk(i: u32) {
     let grid = in_grid(i);
     if (grid) {
         let centre = cell_of(walker.pos);
-        visit_cell(centre, i);
-        for (var y = -1; y <= 1; y = y + 1) {
-            for (var z = -1; z <= 1; z = z + 1) {
-                visit_cell(centre + vec3<i32>(1, y, z), NONE);
-            }
+        // one loop, one call site: the kernel holds one copy of the cell's
+        // walk (lavapipe's compile time grows steeply with a kernel's size)
+        for (var n = 0u; n < 14u; n = n + 1u) {
+            visit_cell(centre + cell_ahead(n), select(NONE, i, n == 0u));
         }
-        for (var z = -1; z <= 1; z = z + 1) {
-            visit_cell(centre + vec3<i32>(0, 1, z), NONE);
-        }
-        visit_cell(centre + vec3<i32>(0, 0, 1), NONE);
     }
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         let j = large_body(k);
