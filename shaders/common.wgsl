@@ -254,12 +254,11 @@ fn quat_to_rotvec(q_in: vec4<f32>) -> vec3<f32> {
     if (s < 1e-12) {
         return 2.0 * q.xyz;
     }
-    var half_angle: f32;
-    if (s <= q.w) {
-        half_angle = atan_precise(s / q.w);
-    } else {
-        half_angle = 1.5707964 - atan_precise(q.w / s);
-    }
+    // atan(s / w), or pi/2 - atan(w / s) past 45 degrees: one call of
+    // atan_precise, so one copy of it where this is inlined
+    let small = s <= q.w;
+    let a = atan_precise(select(q.w / s, s / q.w, small));
+    let half_angle = select(1.5707964 - a, a, small);
     return q.xyz * (2.0 * half_angle / s);
 }
 

@@ -117,9 +117,12 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
         }
     }
     manifolds[slot] = stored;
+    // only an awake partner wakes a sleeper, so of the two checks (a by b,
+    // b by a) only the one for a sleeping a can act if a sleeps, only the
+    // other if not: one check, one copy of it in the kernel
     if (b != GROUND && m.count > 0u) {
-        wake_check(a, b, deepest);
-        wake_check(b, a, deepest);
+        let a_sleeps = asleep(state_in[a]);
+        wake_check(select(b, a, a_sleeps), select(a, b, a_sleeps), deepest);
     }
 }
 
