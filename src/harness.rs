@@ -1,4 +1,4 @@
-//! `verlet bench`: the throughput benchmark's harness (issue 6), in the
+//! `verlet bench`: the throughput benchmark's harness (issues 6 and 13), in the
 //! binary so that the library holds no peer engine; the workloads (the
 //! named cases, the copy kernel) are the library's `verlet::bench`.
 //!
@@ -33,7 +33,7 @@ use verlet::bench::{case, Case, CopyKernel, CASES, QUICK_CASES, SEED};
 use verlet::gpu::Gpu;
 use verlet::render::Renderer;
 use verlet::scene::Scene;
-use verlet::step::Part;
+use verlet::step::{Part, Stage};
 use verlet::world::{self, StageTimes, World};
 use verlet::{scenes, Error};
 
@@ -210,9 +210,11 @@ pub struct Scaling {
     pub spread: f64,
 }
 
-/// A target of issue 6, measured.
+/// A target of an issue (6: cubes falling side by side; 13: piles), measured.
 #[derive(Clone, Debug, Serialize)]
 pub struct Target {
+    /// The issue that set it.
+    pub issue: u32,
     pub target: String,
     /// `None`: not measured in this run.
     pub met: Option<bool>,
@@ -241,7 +243,13 @@ pub struct Report {
     /// Whether start-up times had Mesa's shader cache to draw on.
     pub shader_cache: String,
     pub cases: Vec<CaseResult>,
+    /// Over the cubes cases (issue 6).
     pub scaling: Option<Scaling>,
+    /// Over the pile cases (issue 13).
+    pub pile_scaling: Option<Scaling>,
+    /// Whole `verlet run --builtin cubes --count 10 --steps 1` processes
+    /// with Mesa's shader cache disabled (s; `cold_start`), when measured.
+    pub cold_start_s: Vec<f64>,
     pub targets: Vec<Target>,
 }
 
@@ -453,6 +461,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     // taken after a render pass on the same device come out near zero, so a
     // render before a profile would corrupt the per-stage table.
     let render = if profile_steps > 0 { Some(render_cubes(&gpu)?) } else { None };
+    let cold_start_s = if profile_steps > 0 { cold_start(if opts.quick { 1 } else { 3 }) } else { Vec::new() };
     if let (Some((setup, ms)), Some(r)) = (render, results.iter_mut().find(|r| r.case == "cubes-1k")) {
         r.render_setup_s = Some(setup);
         r.render_ms = Some(ms);
@@ -472,7 +481,9 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
         render_setup_s: render.map(|r| r.0),
         render_ms: render.map(|r| r.1),
         shader_cache: if mesa_cache { "disabled (MESA_SHADER_CACHE_DISABLE)" } else { "Mesa's default (on-disk cache on)" }.into(),
-        scaling: scaling(&results),
+        scaling: scaling(&results, "cubes"),
+        pile_scaling: scaling(&results, "pile"),
+        cold_start_s,
         targets: Vec::new(),
         cases: results,
     };
@@ -745,11 +756,11 @@ fn run_peer(_: &Case, _: &Scene, _: u64, _: usize, _: f64, _: &Options) -> Optio
     None
 }
 
-/// Fits the exponent over the cubes cases of 10 000 bodies and more.
-pub fn scaling(results: &[CaseResult]) -> Option<Scaling> {
+/// Fits the exponent over the cases of `scene` with 10 000 bodies and more.
+pub fn scaling(results: &[CaseResult], scene: &str) -> Option<Scaling> {
     let mut points: Vec<(usize, f64)> = results
         .iter()
-        .filter(|r| r.scene == "cubes" && r.skipped.is_none() && r.bodies >= 10_000 && r.median_ms_per_step.is_finite())
+        .filter(|r| r.scene == scene && r.skipped.is_none() && r.bodies >= 10_000 && r.median_ms_per_step.is_finite())
         .map(|r| (r.bodies, r.median_ms_per_step))
         .collect();
     points.sort_by_key(|p| p.0);
@@ -768,13 +779,21 @@ pub fn scaling(results: &[CaseResult]) -> Option<Scaling> {
     Some(Scaling { points, exponent: sxy / sxx, spread })
 }
 
+/// Issue 6's targets (cubes falling side by side), then issue 13's (piles).
 fn targets(report: &Report) -> Vec<Target> {
+    let mut out = issue6_targets(report);
+    out.extend(issue13_targets(report));
+    out
+}
+
+fn issue6_targets(report: &Report) -> Vec<Target> {
     let cubes = |n: usize| report.cases.iter().find(|r| r.scene == "cubes" && r.bodies == n && r.skipped.is_none());
     let mut out = Vec::new();
     let t10 = "10 000 cubes (300 steps): faster per step than rapier3d";
     out.push(match cubes(10_000) {
         Some(r) => match &r.peer {
             Some(p) => Target {
+                issue: 6,
                 target: t10.into(),
                 met: Some(r.median_ms_per_step < p.median_ms_per_step),
                 measured: format!(
@@ -782,9 +801,14 @@ fn targets(report: &Report) -> Vec<Target> {
                     r.median_ms_per_step, p.median_ms_per_step, p.speedup, r.steps
                 ),
             },
-            None => Target { target: t10.into(), met: None, measured: format!("{:.2} ms/step; no peer run", r.median_ms_per_step) },
+            None => Target {
+                issue: 6,
+                target: t10.into(),
+                met: None,
+                measured: format!("{:.2} ms/step; no peer run", r.median_ms_per_step),
+            },
         },
-        None => Target { target: t10.into(), met: None, measured: "not run".into() },
+        None => Target { issue: 6, target: t10.into(), met: None, measured: "not run".into() },
     });
     let t100 = "100 000 cubes: >= 5x rapier3d's throughput and >= 2M body-steps/s";
     out.push(match cubes(100_000) {
@@ -792,32 +816,36 @@ fn targets(report: &Report) -> Vec<Target> {
             let fast = r.body_steps_per_s >= 2e6;
             match &r.peer {
                 Some(p) => Target {
+                    issue: 6,
                     target: t100.into(),
                     met: Some(fast && p.speedup >= 5.0),
                     measured: format!("{:.2}x rapier, {:.2}M body-steps/s", p.speedup, r.body_steps_per_s / 1e6),
                 },
                 None => Target {
+                    issue: 6,
                     target: t100.into(),
                     met: if fast { None } else { Some(false) },
                     measured: format!("{:.2}M body-steps/s; no peer run", r.body_steps_per_s / 1e6),
                 },
             }
         }
-        None => Target { target: t100.into(), met: None, measured: "not run".into() },
+        None => Target { issue: 6, target: t100.into(), met: None, measured: "not run".into() },
     });
     let largest = report.cases.iter().filter(|r| r.scene == "cubes" && r.skipped.is_none()).max_by_key(|r| r.bodies);
     let tint = "integrate pass within 2x of a memory-bound copy of the state";
     out.push(match largest.and_then(|r| Some((r, r.integrate_ms_per_pass?, r.copy_ms_per_pass?))) {
         Some((r, i, c)) => Target {
+            issue: 6,
             target: tint.into(),
             met: Some(i <= 2.0 * c),
             measured: format!("{}: integrate {:.3} ms/pass vs copy {:.3} ms/pass ({:.2}x)", r.case, i, c, i / c),
         },
-        None => Target { target: tint.into(), met: None, measured: "not profiled".into() },
+        None => Target { issue: 6, target: tint.into(), met: None, measured: "not profiled".into() },
     });
     let tmem = "GPU memory <= 512 B/body (grid and contacts included)";
     out.push(match largest {
         Some(r) => Target {
+            issue: 6,
             target: tmem.into(),
             met: Some(r.gpu_bytes_per_body <= 512.0),
             measured: format!(
@@ -828,11 +856,12 @@ fn targets(report: &Report) -> Vec<Target> {
                 report.bytes_per_body
             ),
         },
-        None => Target { target: tmem.into(), met: None, measured: "not run".into() },
+        None => Target { issue: 6, target: tmem.into(), met: None, measured: "not run".into() },
     });
     let tscale = "10k to 1M: cost per body-step flat within 1.5x";
     out.push(match &report.scaling {
         Some(s) => Target {
+            issue: 6,
             target: tscale.into(),
             met: Some(s.spread <= 1.5 && s.points.last().is_some_and(|p| p.0 >= 1_000_000)),
             measured: format!(
@@ -844,8 +873,162 @@ fn targets(report: &Report) -> Vec<Target> {
                 if s.points.last().unwrap().0 < 1_000_000 { " (1M not reached)" } else { "" }
             ),
         },
-        None => Target { target: tscale.into(), met: None, measured: "fewer than two cubes cases of >= 10k bodies".into() },
+        None => {
+            Target { issue: 6, target: tscale.into(), met: None, measured: "fewer than two cubes cases of >= 10k bodies".into() }
+        }
     });
+    out
+}
+
+/// Issue 13's targets: the pile cases (`verlet scene pile`: cubes dropped
+/// in four layers that heap up) against rapier3d, the narrowphase's share of
+/// a step, memory, size, scaling and the cold start.
+fn issue13_targets(report: &Report) -> Vec<Target> {
+    let pile = |n: usize| report.cases.iter().find(|r| r.scene == "pile" && r.bodies == n && r.skipped.is_none());
+    let target = |text: &str, met: Option<bool>, measured: String| Target { issue: 13, target: text.into(), met, measured };
+    let goal = |met: bool| if met { "met" } else { "not yet" };
+    let mut out = Vec::new();
+    // (bodies, target, the least speed-up that meets it: pile-10k faster, pile-1k at least as fast, and the goal's)
+    let against_peer = [
+        (10_000, "pile-10k: faster per step than rapier3d (floor), 5x (goal)", 1.0, Some(5.0)),
+        (1_000, "pile-1k: at least rapier3d's speed", 1.0, None),
+    ];
+    for (n, text, floor, want) in against_peer {
+        out.push(match pile(n).map(|r| (r, r.peer.as_ref())) {
+            Some((r, Some(p))) => {
+                let met = if n == 10_000 { p.speedup > floor } else { p.speedup >= floor };
+                let goal_text = want.map_or(String::new(), |g| format!("; goal {g}x: {}", goal(p.speedup >= g)));
+                target(
+                    text,
+                    Some(met),
+                    format!(
+                        "{:.2} ms/step vs rapier {:.2} ms/step ({:.2}x) over {} steps{goal_text}",
+                        r.median_ms_per_step, p.median_ms_per_step, p.speedup, r.steps
+                    ),
+                )
+            }
+            Some((r, None)) => target(text, None, format!("{:.2} ms/step; no peer run", r.median_ms_per_step)),
+            None => target(text, None, "not run".into()),
+        });
+    }
+    // the narrowphase proper (pairs to manifolds: Part 2 of the issue); the
+    // pair list (Part 1) and the contact lists (Part 3) reported beside it
+    let tnp = "pile-10k: the narrowphase at most a quarter of a step";
+    out.push(match pile(10_000).and_then(|r| r.stages.as_ref()) {
+        Some(st) => {
+            let sum = |stages: &[Stage]| {
+                st.passes.iter().filter(|(name, _)| stages.iter().any(|s| s.name() == name)).map(|x| x.1).sum::<f64>()
+            };
+            let narrow = sum(&[Stage::Narrowphase, Stage::NarrowphaseGround, Stage::NarrowphaseClip]);
+            let lists = sum(&[Stage::PairsCount, Stage::PairsScanBlocks, Stage::PairsScanSums, Stage::PairsWrite, Stage::ContactLists]);
+            let share = narrow / st.total;
+            target(
+                tnp,
+                Some(share <= 0.25),
+                format!(
+                    "{:.0}% ({narrow:.2} of {:.2} ms a step: narrowphase, narrowphase_ground, narrowphase_clip); {:.0}% with the pair list and the contact lists",
+                    100.0 * share,
+                    st.total,
+                    100.0 * (narrow + lists) / st.total
+                ),
+            )
+        }
+        None => target(tnp, None, "not profiled".into()),
+    });
+    let tmem = "GPU memory at most 512 B/body in a settled pile";
+    let largest = report.cases.iter().filter(|r| r.scene == "pile" && r.skipped.is_none()).max_by_key(|r| r.bodies);
+    out.push(match largest {
+        Some(r) => target(
+            tmem,
+            Some(r.gpu_bytes_per_body <= 512.0),
+            format!(
+                "{}: {:.0} B/body after the run, pools grown ({:.0} at start; `verlet info`: {})",
+                r.case,
+                r.gpu_bytes_per_body,
+                r.gpu_bytes_at_start as f64 / r.bodies.max(1) as f64,
+                report.bytes_per_body
+            ),
+        ),
+        None => target(tmem, None, "no pile case run".into()),
+    });
+    let million = report.cases.iter().find(|r| r.bodies >= 1_000_000 && r.skipped.is_none());
+    out.push(target(
+        "1 000 000 cubes fit this adapter",
+        Some(report.max_bodies >= 1_000_000),
+        format!(
+            "largest scene {} bodies{}",
+            report.max_bodies,
+            million.map_or(String::new(), |r| format!("; {} ran at {} ms/step", r.case, fmt_ms(r.median_ms_per_step)))
+        ),
+    ));
+    let tscale = "piles 10k to 1M: cost per body-step within 2x (floor), 1.5x (goal)";
+    out.push(match &report.pile_scaling {
+        Some(sc) => {
+            let (first, top) = (sc.points[0].0, sc.points[sc.points.len() - 1].0);
+            let reached = top >= 1_000_000;
+            target(
+                tscale,
+                reached.then_some(sc.spread <= 2.0),
+                format!(
+                    "exponent {:.2} over {first} to {top} bodies, spread {:.2}x (goal 1.5x: {}){}",
+                    sc.exponent,
+                    sc.spread,
+                    goal(sc.spread <= 1.5),
+                    if reached { "" } else { "; 1M not run" }
+                ),
+            )
+        }
+        None => target(tscale, None, "fewer than two pile cases of >= 10k bodies".into()),
+    });
+    let tcold = "cold start of a 10-cube scene, whole process, Mesa's shader cache disabled: at most 5 s (floor), 2 s (goal)";
+    out.push(if report.cold_start_s.is_empty() {
+        target(tcold, None, "not measured (--profile-steps 0, or a run failed)".into())
+    } else {
+        let m = median(&report.cold_start_s);
+        target(tcold, Some(m <= 5.0), format!("{m:.2} s (median of {}); goal 2 s: {}", report.cold_start_s.len(), goal(m <= 2.0)))
+    });
+    out
+}
+
+/// Times `runs` whole processes of this binary running `run --builtin
+/// cubes --count 10 --steps 1` with Mesa's shader cache disabled (issue 13's
+/// cold start: every kernel compiled from nothing), each from its start to
+/// its exit (s). Empty, with a warning, if one cannot be run or fails.
+fn cold_start(runs: usize) -> Vec<f64> {
+    use std::process::{Command, Stdio};
+    let exe = match std::env::current_exe() {
+        Ok(exe) => exe,
+        Err(e) => {
+            progress!("warning: cold start not measured: this program's path is unknown: {e}");
+            return Vec::new();
+        }
+    };
+    let mut out = Vec::new();
+    for _ in 0..runs {
+        let t = Instant::now();
+        let status = Command::new(&exe)
+            .args(["run", "--builtin", "cubes", "--count", "10", "--steps", "1"])
+            .env("MESA_SHADER_CACHE_DISABLE", "true")
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status();
+        match status {
+            Ok(s) if s.success() => out.push(t.elapsed().as_secs_f64()),
+            Ok(s) => {
+                progress!(
+                    "warning: cold start not measured: `{} run --builtin cubes --count 10 --steps 1` exited with {s}",
+                    exe.display()
+                );
+                return Vec::new();
+            }
+            Err(e) => {
+                progress!("warning: cold start not measured: could not start {}: {e}", exe.display());
+                return Vec::new();
+            }
+        }
+    }
+    progress!("cold start (10 cubes, Mesa's shader cache disabled): {:.2} s (median of {runs})", median(&out));
     out
 }
 
@@ -994,24 +1177,38 @@ pub fn table(r: &Report) -> String {
             fmt_ms(ms)
         );
     }
-    if let Some(sc) = &r.scaling {
-        let pts: Vec<String> = sc.points.iter().map(|(n, ms)| format!("{n}: {:.1} ns/body-step", ms * 1e6 / *n as f64)).collect();
+    for (family, scaling) in [("cubes", &r.scaling), ("piles", &r.pile_scaling)] {
+        if let Some(sc) = scaling {
+            let pts: Vec<String> =
+                sc.points.iter().map(|(n, ms)| format!("{n}: {:.1} ns/body-step", ms * 1e6 / *n as f64)).collect();
+            let _ = writeln!(
+                s,
+                "\nscaling ({family}): time per step ~ bodies^{:.2} (log-log least squares over {}); cost per body-step spread {:.2}x",
+                sc.exponent,
+                pts.join(", "),
+                sc.spread
+            );
+        }
+    }
+    if !r.cold_start_s.is_empty() {
+        let runs: Vec<String> = r.cold_start_s.iter().map(|t| format!("{t:.2}")).collect();
         let _ = writeln!(
             s,
-            "\nscaling: time per step ~ bodies^{:.2} (log-log least squares over {}); cost per body-step spread {:.2}x",
-            sc.exponent,
-            pts.join(", "),
-            sc.spread
+            "\ncold start: `verlet run --builtin cubes --count 10 --steps 1`, whole process, MESA_SHADER_CACHE_DISABLE=true: {:.2} s (median of {} s)",
+            median(&r.cold_start_s),
+            runs.join(", ")
         );
     }
-    let _ = writeln!(s, "\ntargets (issue 6):\n");
-    for t in &r.targets {
-        let mark = match t.met {
-            Some(true) => "met",
-            Some(false) => "MISSED",
-            None => "not measured",
-        };
-        let _ = writeln!(s, "- {}: **{mark}** — {}", t.target, t.measured);
+    for issue in [6, 13] {
+        let _ = writeln!(s, "\ntargets (issue {issue}):\n");
+        for t in r.targets.iter().filter(|t| t.issue == issue) {
+            let mark = match t.met {
+                Some(true) => "met",
+                Some(false) => "MISSED",
+                None => "not measured",
+            };
+            let _ = writeln!(s, "- {}: **{mark}** — {}", t.target, t.measured);
+        }
     }
     s
 }
@@ -1072,7 +1269,7 @@ mod tests {
     fn exponent_of_a_power_law() {
         let mk = |n: usize, ms: f64| CaseResult { scene: "cubes".into(), bodies: n, median_ms_per_step: ms, ..result_stub() };
         let rs = vec![mk(10_000, 2.0), mk(100_000, 20.0), mk(1_000_000, 200.0), mk(1_000, 99.0)];
-        let s = scaling(&rs).unwrap();
+        let s = scaling(&rs, "cubes").unwrap();
         assert!((s.exponent - 1.0).abs() < 1e-9, "{}", s.exponent);
         assert!((s.spread - 1.0).abs() < 1e-9);
         assert_eq!(s.points.len(), 3);
@@ -1082,6 +1279,128 @@ mod tests {
     fn median_of_odd_and_even_counts() {
         assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+    }
+
+    /// A pile case with a peer at `speedup` and, for 10k, a profile.
+    fn pile(n: usize, ms: f64, speedup: f64, bytes_per_body: f64) -> CaseResult {
+        let peer = PeerResult {
+            engine: "rapier3d".into(),
+            threads: "1".into(),
+            sleeping: false,
+            num_solver_iterations: 4,
+            setup_s: 0.0,
+            ms_per_step: vec![ms * speedup],
+            median_ms_per_step: ms * speedup,
+            body_steps_per_s: n as f64 / (ms * speedup * 1e-3),
+            speedup,
+            mean_height: 1.0,
+        };
+        let stages = (n == 10_000).then(|| Stages {
+            source: "GPU timestamps".into(),
+            steps: 10,
+            broadphase: 2.0,
+            narrowphase: 20.0,
+            integrate: 2.0,
+            solve: 30.0,
+            restitution: 6.0,
+            total: 60.0,
+            passes: vec![
+                ("pairs_count".into(), 8.0),
+                ("pairs_write".into(), 1.0),
+                ("narrowphase".into(), 6.0),
+                ("narrowphase_ground".into(), 0.5),
+                ("contact_lists".into(), 2.0),
+                ("narrowphase_clip".into(), 2.5),
+                ("solve_contacts".into(), 22.0),
+            ],
+        });
+        CaseResult {
+            case: format!("pile-{n}"),
+            scene: "pile".into(),
+            bodies: n,
+            steps: 60,
+            median_ms_per_step: ms,
+            gpu_bytes_per_body: bytes_per_body,
+            gpu_bytes_at_start: 1204 * n as u64,
+            stages,
+            peer: Some(peer),
+            ..result_stub()
+        }
+    }
+
+    fn report_of(cases: Vec<CaseResult>, max_bodies: u64, cold_start_s: Vec<f64>) -> Report {
+        Report {
+            command: String::new(),
+            cpu: String::new(),
+            cores: 2,
+            adapter: String::new(),
+            gpu_timestamps: true,
+            max_bodies,
+            max_storage_buffer_binding_size: 1 << 27,
+            bytes_per_body: 1204,
+            iterations: String::new(),
+            peer: String::new(),
+            gpu_open_s: 0.3,
+            render_setup_s: None,
+            render_ms: None,
+            shader_cache: String::new(),
+            scaling: scaling(&cases, "cubes"),
+            pile_scaling: scaling(&cases, "pile"),
+            cold_start_s,
+            cases,
+            targets: Vec::new(),
+        }
+    }
+
+    fn verdicts(r: &Report) -> Vec<(String, Option<bool>)> {
+        issue13_targets(r).into_iter().map(|t| (t.target, t.met)).collect()
+    }
+
+    #[test]
+    fn issue_13s_targets_read_the_pile_cases() {
+        let r = report_of(
+            vec![pile(1_000, 8.0, 0.65, 1241.0), pile(10_000, 60.0, 1.5, 1359.0), pile(100_000, 600.0, 2.4, 1241.0)],
+            1_048_560,
+            vec![1.9, 1.8, 2.4],
+        );
+        let v = verdicts(&r);
+        let met =
+            |prefix: &str| v.iter().find(|(t, _)| t.starts_with(prefix)).unwrap_or_else(|| panic!("no target {prefix}: {v:?}")).1;
+        assert_eq!(met("pile-10k: faster"), Some(true));
+        assert_eq!(met("pile-1k"), Some(false));
+        // 9 of 60 ms: narrowphase, ground and clip
+        assert_eq!(met("pile-10k: the narrowphase"), Some(true));
+        // the largest pile case's bytes
+        assert_eq!(met("GPU memory"), Some(false));
+        assert_eq!(met("1 000 000 cubes"), Some(true));
+        // 1M was not run: the scaling is reported, not judged
+        assert_eq!(met("piles 10k to 1M"), None);
+        assert_eq!(met("cold start"), Some(true));
+        let text = issue13_targets(&r).into_iter().map(|t| t.measured).collect::<Vec<_>>().join("\n");
+        assert!(text.contains("(1.50x)") && text.contains("goal 5x: not yet"), "{text}");
+        assert!(text.contains("15% (9.00 of 60.00 ms"), "{text}");
+        assert!(text.contains("33% with the pair list"), "{text}");
+        assert!(text.contains("pile-100000: 1241 B/body"), "{text}");
+        assert!(text.contains("1.90 s (median of 3); goal 2 s: met"), "{text}");
+    }
+
+    #[test]
+    fn issue_13s_targets_missed_and_unmeasured() {
+        let mut slow = pile(10_000, 60.0, 0.9, 400.0);
+        if let Some(st) = slow.stages.as_mut() {
+            st.passes.push(("narrowphase".into(), 10.0));
+        }
+        let r = report_of(vec![slow, pile(1_000_000, 9000.0, 1.0, 400.0)], 900_000, Vec::new());
+        let v = verdicts(&r);
+        let met = |prefix: &str| v.iter().find(|(t, _)| t.starts_with(prefix)).unwrap().1;
+        assert_eq!(met("pile-10k: faster"), Some(false));
+        assert_eq!(met("pile-1k"), None);
+        assert_eq!(met("pile-10k: the narrowphase"), Some(false));
+        assert_eq!(met("GPU memory"), Some(true));
+        assert_eq!(met("1 000 000 cubes"), Some(false));
+        // 6 us a body-step at 10k, 9 at 1M: within 2x
+        assert_eq!(met("piles 10k to 1M"), Some(true));
+        assert_eq!(met("cold start"), None);
     }
 
     fn result_stub() -> CaseResult {
