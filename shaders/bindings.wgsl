@@ -34,6 +34,8 @@
 // step_index, both atomicMin-ed from NO_FAULT (0xffffffff, written when the
 // buffer is made); status[8..11]: the narrowphase's indirect dispatch
 // (workgroups over the pairs, 1, 1), copied out before it runs;
+// status[11]: 1 if a grid body sleeps this step (grid_count sets it,
+// contact_lists clears it: the pair walks read it, see pairs.wgsl);
 // status[12..15]: the contact passes' (workgroups over the manifolds, 1, 1),
 // written by contact_lists and copied out after it; 16 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;

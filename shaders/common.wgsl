@@ -157,7 +157,8 @@ const SUPPORT_ONE: f32 = 32767.0;
 // Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
 // how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of
 // both, the cursor its incoming pairs are counted and listed by, its wake
-// flags (WOKEN_*), whether contacts can move it this step, how many of its
+// flags (WOKEN_*), whether contacts can move it this step (MOVES, SLEEPS,
+// STAYS_FIXED), how many of its
 // pairs have a manifold (contact_lists: its list then starts with their
 // contact references, see `contact_ref`), and its bounds: the half extents
 // of its world box grown by its reach (how far it may move this step, m),
@@ -180,6 +181,14 @@ struct PairMeta {
     normal_split: f32,
     reach: f32,
 }
+
+// pair_meta[i].moves (grid_count): contacts can move the body this step
+// (awake, or asleep but woken by the last step's narrowphase); it sleeps
+// (and its pairs are found by the bodies that move: pairs.wgsl); it is
+// fixed.
+const MOVES: u32 = 1u;
+const SLEEPS: u32 = 2u;
+const STAYS_FIXED: u32 = 0u;
 
 // pair_meta[i].woken bits, WOKEN_NOW and WOKEN_LAST (shared with Rust,
 // whose snapshots keep them): set by the narrowphase when an awake partner

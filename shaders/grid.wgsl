@@ -78,14 +78,21 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let reach = reach_of(i);
-    let moves = !is_fixed(props[i]) && (!asleep(state_in[i]) || atomicLoad(&pair_meta[i].woken) != 0u);
-    pair_meta[i].moves = u32(moves);
+    let fixed = is_fixed(props[i]);
+    let moves = !fixed && (!asleep(state_in[i]) || atomicLoad(&pair_meta[i].woken) != 0u);
+    let sleeps = !fixed && !moves;
+    pair_meta[i].moves = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
     pair_meta[i].reach = reach;
     pair_meta[i].extent = world_extent(i) + vec3<f32>(reach);
     pair_meta[i].bound = props[i].half_extents.w + reach;
     if (!in_grid(i)) {
         return;
+    }
+    // the pair walks of the bodies that move look for sleepers behind them
+    // too (pairs.wgsl); one store does, the rest see it set
+    if (sleeps && atomicLoad(&status[11]) == 0u) {
+        atomicStore(&status[11], 1u);
     }
     atomicAdd(&cell_count[bucket_of(cell_of(state_in[i].pos))], 1u);
 }

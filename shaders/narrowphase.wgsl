@@ -280,6 +280,8 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&status[12], (used + WORKGROUP - 1u) / WORKGROUP);
         atomicStore(&status[13], 1u);
         atomicStore(&status[14], 1u);
+        // the pair walks are done: grid_count sets it again next step
+        atomicStore(&status[11], 0u);
     }
     if (i >= params.body_count) {
         return;

@@ -27,14 +27,17 @@
 // the one whose cell is behind the other's (the other's cell is among its
 // 13 cells ahead: +x, or the same x and +y, or the same x and y and +z), so
 // each walk visits half the neighbourhood; of two in one cell, the lower
-// index. A grid body owns its pairs with every large body (it always walks
-// them all); a large body (kept out of the grid) owns only its pairs with
-// large bodies of higher index, so it never walks the cells; every body
-// owns its pair with the ground. A pair is wanted when the two bodies'
-// bounds come within the margin, they are not joined, and one of them
-// moves: not fixed and awake, or asleep but woken by the last step's
-// narrowphase. Only the owner decides, alike in both walks (the test reads
-// only what these passes do not write).
+// index; but of a sleeper and a body that moves, the one that moves,
+// wherever the sleeper lies (a sleeper walks no cells; where any grid body
+// sleeps, the bodies that move also walk the 13 cells behind them for
+// sleepers). A grid body owns its pairs with every large body (it always
+// walks them all); a large body (kept out of the grid) owns only its pairs
+// with large bodies of higher index, so it never walks the cells; every
+// body owns its pair with the ground. A pair is wanted when the two
+// bodies' bounds come within the margin, they are not joined, and one of
+// them moves: not fixed and awake, or asleep but woken by the last step's
+// narrowphase (pair_meta's MOVES). Only the owner decides, alike in both
+// walks (the test reads only what these passes do not write).
 
 // Gap kept as contact whatever the speed (m).
 const CONTACT_MARGIN: f32 = 0.02;
@@ -82,7 +85,7 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
 // 81.9k to 44.6k, and by 8-17% once the pile has landed. (Every sum here is
 // of one term of each body, so it is the same bits whichever body walks.)
 fn wanted(j: u32, pos_j: vec3<f32>) -> bool {
-    if (!walker.moves && pair_meta[j].moves == 0u) {
+    if (!walker.moves && pair_meta[j].moves != MOVES) {
         return false;
     }
     let d = walker.pos - pos_j;
@@ -96,7 +99,7 @@ fn wanted(j: u32, pos_j: vec3<f32>) -> bool {
 
 // Whether body i is near enough the ground for a ground pair.
 fn wants_ground(i: u32) -> bool {
-    return params.has_ground != 0u && pair_meta[i].moves != 0u
+    return params.has_ground != 0u && pair_meta[i].moves == MOVES
         && state_in[i].pos.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
 }
 
@@ -155,13 +158,16 @@ fn visit(j: u32, pos_j: vec3<f32>) {
     owned = owned + 1u;
 }
 
-// Every body whose own cell is c (a bucket may also hold other cells) and
-// whose index is above `above` (the walker's own cell; NONE: every body),
-// up to the first whose box begins beyond the walker's along x by more than
-// the margin: a bucket is sorted by where its boxes begin (grid_sort), so
-// no later one can be wanted either. (`wanted` decides, with its own
-// roundings; the stop keeps a slack of 1e-4 m and 1e-5 of the position.)
-fn visit_cell(c: vec3<i32>, above: u32) {
+// Every body whose own cell is c (a bucket may also hold other cells) that
+// the walk owns a pair with: in the walker's own cell (`above` the
+// walker's index; NONE for another cell) those of higher index and the
+// sleepers, in a cell behind the walker's (`behind`) the sleepers only,
+// in one ahead of it every body; up to the first whose box begins beyond
+// the walker's along x by more than the margin: a bucket is sorted by
+// where its boxes begin (grid_sort), so no later one can be wanted either.
+// (`wanted` decides, with its own roundings; the stop keeps a slack of
+// 1e-4 m and 1e-5 of the position.)
+fn visit_cell(c: vec3<i32>, above: u32, behind: bool) {
     let h = bucket_of(c);
     let end = cell_start[h + 1u];
     let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
@@ -171,15 +177,31 @@ fn visit_cell(c: vec3<i32>, above: u32) {
         if (pos_j.x - pair_meta[j].extent.x > stop) {
             break;
         }
-        if ((above == NONE || j > above) && all(cell_of(pos_j) == c)) {
+        // a cell ahead: every body; the own cell: those of higher index, and
+        // of the others the sleepers; a cell behind: the sleepers (read only
+        // then: a load a candidate is what the walk costs)
+        var owned = above == NONE || j > above;
+        if (!owned || behind) {
+            owned = pair_meta[j].moves == SLEEPS;
+        }
+        if (owned && all(cell_of(pos_j) == c)) {
             visit(j, pos_j);
         }
     }
 }
 
 // The n-th cell a walk visits, as an offset from the walker's own (n = 0):
-// the 9 cells at +x (y, then z, from -1 to 1), the 3 at the same x and +y
-// (z from -1 to 1), the one at the same x and y and +z.
+// the 13 ahead of it (n = 1..13, cell_ahead), then the same 13 behind it,
+// mirrored (n = 14..26).
+fn walk_cell(n: u32) -> vec3<i32> {
+    let behind = n > 13u;
+    let c = cell_ahead(select(n, n - 13u, behind));
+    return select(c, -c, behind);
+}
+
+// Cell n of the 13 ahead of the walker's own (n = 0 is its own): the 9 at
+// +x (y, then z, from -1 to 1), the 3 at the same x and +y (z from -1 to
+// 1), the one at the same x and y and +z.
 fn cell_ahead(n: u32) -> vec3<i32> {
     let m = i32(n) - 1;
     if (n == 0u) {
@@ -195,9 +217,14 @@ fn cell_ahead(n: u32) -> vec3<i32> {
 }
 
 // The ground, then (for a body in the grid) its own cell and the 13 cells
-// ahead of it, then the large bodies it owns pairs with.
+// ahead of it, and the 13 behind it for sleepers where any grid body
+// sleeps, then the large bodies it owns pairs with. A sleeper walks no
+// cells: pairs of sleepers are not wanted, and a body that moves owns its
+// pairs with sleepers wherever they lie (a resting pile of sleepers made
+// pairs_count the largest pass of its step, every sleeper walking 14 cells
+// for nothing).
 fn walk(i: u32) {
-    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].bound, pair_meta[i].moves != 0u,
+    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].bound, pair_meta[i].moves == MOVES,
                     vec2<u32>(joint_start[i], joint_start[i + 1u]));
     owned = 0u;
     if (wants_ground(i)) {
@@ -209,13 +236,13 @@ fn walk(i: u32) {
         owned = owned + 1u;
     }
     let grid = in_grid(i);
-    if (grid) {
-        let centre = cell_of(walker.pos);
-        // one loop, one call site: the kernel holds one copy of the cell's
-        // walk (lavapipe's compile time grows steeply with a kernel's size)
-        for (var n = 0u; n < 14u; n = n + 1u) {
-            visit_cell(centre + cell_ahead(n), select(NONE, i, n == 0u));
-        }
+    let sleeps = pair_meta[i].moves == SLEEPS;
+    let cells = select(select(14u, 27u, walker.moves && atomicLoad(&status[11]) != 0u), 0u, sleeps || !grid);
+    let centre = cell_of(walker.pos);
+    // one loop, one call site: the kernel holds one copy of the cell's walk
+    // (lavapipe's compile time grows steeply with a kernel's size)
+    for (var n = 0u; n < cells; n = n + 1u) {
+        visit_cell(centre + walk_cell(n), select(NONE, i, n == 0u), n > 13u);
     }
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         let j = large_body(k);

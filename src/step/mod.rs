@@ -215,15 +215,15 @@ impl Stage {
     pub fn reads(self) -> &'static [Buffer] {
         use Buffer::*;
         match self {
-            Stage::GridCount => &[Params, Props, StateIn, CellCount, PairMeta],
+            Stage::GridCount => &[Params, Props, StateIn, CellCount, Status, PairMeta],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, CellStart, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
             Stage::GridSort => &[Params, StateIn, CellStart, Sorted, PairMeta],
-            Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, JointStart, JointRefs, PairMeta],
+            Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, Status, JointStart, JointRefs, PairMeta],
             Stage::PairsWrite => {
-                &[Params, Props, StateIn, CellStart, BlockSums, Sorted, JointStart, JointRefs, PairMeta, BodyPairs]
+                &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Status, JointStart, JointRefs, PairMeta, BodyPairs]
             }
             Stage::Narrowphase => &[Params, Props, StateIn, Pairs, Status, PairMeta],
             Stage::NarrowphaseGround => &[Params, Props, StateIn, Pairs, Status, PairMeta],
