@@ -195,3 +195,88 @@ fn a_slept_thirty_row_pyramid_woken_by_a_poke_stays_put() {
     assert!(rose < 0.01, "the top box jumped {rose} m");
     assert!(moved < 0.02, "a box moved {moved} m");
 }
+
+/// A sleeper walks no grid cells: the bodies that move own their pairs with
+/// sleepers, in their own cell, ahead of it and behind it (pairs.wgsl).
+/// Boxes dropped onto a bed of sleeping boxes, over places that put the
+/// bed's boxes in every relation to their cells, must each land on it: a
+/// pair with a sleeper that no walk listed would let the box fall through.
+#[test]
+fn boxes_dropped_on_a_bed_of_sleepers_land_on_it_wherever_they_fall() {
+    let mut scene = scenes::stack(1);
+    scene.bodies.clear();
+    for i in 0..7 {
+        for k in 0..7 {
+            scene.bodies.push(box_body([0.5; 3], [(i as f32 - 3.0) * 1.02, 0.5, (k as f32 - 3.0) * 1.02]));
+        }
+    }
+    let bed = scene.bodies.len();
+    // they reach the bed's top (y = 1) at about 1.45 s, at 14 m/s
+    let drops =
+        [[-2.63, -2.41], [2.2, 1.7], [0.51, -0.49], [-1.5, 2.6], [2.45, -2.3], [-2.7, 0.4], [0.9, 2.2], [-0.3, 0.8], [1.4, -1.3]];
+    for [x, z] in drops {
+        scene.bodies.push(box_body([0.5; 3], [x, 12.0, z]));
+    }
+    let Some(mut w) = world(&scene) else { return };
+    w.step(80).unwrap();
+    let before = w.read_state().unwrap();
+    assert!(before[..bed].iter().all(|b| b.asleep), "the bed should sleep before the boxes arrive");
+    assert!(before[bed..].iter().all(|b| b.position[1] > 2.5), "a box arrived too early");
+    let mut lowest = vec![f32::MAX; drops.len()];
+    for _ in 0..60 {
+        w.step(1).unwrap();
+        for (low, b) in lowest.iter_mut().zip(&w.read_state().unwrap()[bed..]) {
+            *low = low.min(b.position[1]);
+        }
+    }
+    eprintln!("lowest centres of the dropped boxes: {lowest:?}");
+    for (k, low) in lowest.iter().enumerate() {
+        assert!(*low > 1.35, "box {k} dropped at {:?} went down to y = {low} (resting on the bed: 1.5)", drops[k]);
+    }
+    w.step(240).unwrap();
+    let after = w.read_state().unwrap();
+    for (k, b) in after[bed..].iter().enumerate() {
+        assert!((b.position[1] - 1.5).abs() < 0.05, "box {k} dropped at {:?} rests at y = {}", drops[k], b.position[1]);
+    }
+}
+
+/// The restitution pass computes each point's bounce as if that point
+/// alone turned the approach around; a box landing flat across four boxes
+/// that stay (asleep, or fixed) touches them at sixteen points, most near
+/// its middle, and their summed bounces sent it off at 40 m/s after it hit
+/// them at 14 (restitution 0.2). It must leave at no more than its
+/// restitution times the speed it came with, and come to rest on them.
+#[test]
+fn a_box_landing_across_four_that_stay_bounces_no_more_than_its_restitution() {
+    for fixed in [false, true] {
+        let mut scene = scenes::stack(1);
+        scene.bodies.clear();
+        for (x, z) in [(-0.51, -0.51), (0.51, -0.51), (-0.51, 0.51), (0.51, 0.51)] {
+            let mut b = box_body([0.5; 3], [x, 0.5, z]);
+            b.fixed = fixed;
+            scene.bodies.push(b);
+        }
+        // lands flat across all four at about 1.45 s, at 14 m/s
+        scene.bodies.push(box_body([0.5; 3], [0.0, 12.0, 0.0]));
+        let e = scene.settings.restitution;
+        let Some(mut w) = world(&scene) else { return };
+        w.step(80).unwrap();
+        let before = w.read_state().unwrap();
+        assert!(fixed || before[..4].iter().all(|b| b.asleep), "the four should sleep before the box arrives");
+        let (mut approach, mut leave) = (0.0f32, 0.0f32);
+        for _ in 0..40 {
+            w.step(1).unwrap();
+            let vy = w.read_state().unwrap()[4].linear_velocity[1];
+            if leave == 0.0 {
+                approach = approach.max(-vy);
+            }
+            leave = leave.max(vy);
+        }
+        eprintln!("fixed {fixed}: hit at {approach} m/s, left at {leave} m/s (e = {e})");
+        assert!(approach > 13.0, "the box came at {approach} m/s");
+        assert!(leave <= 1.05 * e * approach, "the box left at {leave} m/s after hitting at {approach} (e = {e})");
+        w.step(240).unwrap();
+        let top = w.read_state().unwrap()[4];
+        assert!((top.position[1] - 1.5).abs() < 0.02, "the box rests at y = {} (on the four: 1.5)", top.position[1]);
+    }
+}
