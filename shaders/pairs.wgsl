@@ -180,11 +180,11 @@ fn visit_cell(c: vec3<i32>, above: u32, behind: bool) {
         // a cell ahead: every body; the own cell: those of higher index, and
         // of the others the sleepers; a cell behind: the sleepers (read only
         // then: a load a candidate is what the walk costs)
-        var owned = above == NONE || j > above;
-        if (!owned || behind) {
-            owned = pair_meta[j].moves == SLEEPS;
+        var takes = above == NONE || j > above;
+        if (!takes || behind) {
+            takes = pair_meta[j].moves == SLEEPS;
         }
-        if (owned && all(cell_of(pos_j) == c)) {
+        if (takes && all(cell_of(pos_j) == c)) {
             visit(j, pos_j);
         }
     }
