@@ -66,7 +66,7 @@ struct BenchArgs {
     /// A short run: fewer cases, steps and repetitions.
     #[arg(long)]
     quick: bool,
-    /// Steps timed stage by stage after the repetitions (default 10; 3 with --quick; 0: none).
+    /// Steps timed stage by stage after the repetitions (default 10; 3 with --quick; 0: none, and no render and no cold-start runs).
     #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     profile_steps: Option<u64>,
     /// Write the full report as JSON here.
