@@ -18,6 +18,9 @@
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
 
+// An EndSnap's flags in this pass: one of the manifold's points bounced.
+const SNAP_BOUNCE: u32 = 1u;
+
 // Velocities a pose implies: disp / dt (disp = x - x_prev) and the rotation q q_prev^*.
 fn pose_velocity(disp: vec3<f32>, rot: vec4<f32>, prev_rot: vec4<f32>) -> Velocity {
     let v = disp / params.dt;
@@ -140,8 +143,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     // across four sleeping boxes had sixteen points, and left at 40 m/s
     // after hitting them at 14), so the sum is scaled to what moving the
     // two bodies apart without turning asks for, never up, as the solve's
-    // pushes are; and against an end that stays it is split among the
-    // body's manifolds with such ends (`split`), which each ask the same.
+    // pushes are. (Several manifolds asking one bounce: see restitution.)
     var pair_w = 0.0;
     if (ea.moves) {
         pair_w = pair_w + ea.inv_inertia.w;
@@ -149,12 +151,13 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (eb.moves) {
         pair_w = pair_w + eb.inv_inertia.w;
     }
-    let bounce_scale = min(1.0, 1.0 / max(pair_w * bounce_inv_w, 1e-30)) / split;
+    let bounce_scale = min(1.0, 1.0 / max(pair_w * bounce_inv_w, 1e-30));
     j = j + bounce_j * bounce_scale;
     moment_a = moment_a + bounce_moment_a * bounce_scale;
     moment_b = moment_b + bounce_moment_b * bounce_scale;
-    snaps[contact_ref(k, false)] = end_snap(ea, -j, -moment_a, acting, 0u);
-    snaps[contact_ref(k, true)] = end_snap(eb, j, moment_b, acting, 0u);
+    let flags = select(0u, SNAP_BOUNCE, bounce_inv_w > 0.0);
+    snaps[contact_ref(k, false)] = end_snap(ea, -j, -moment_a, acting, flags);
+    snaps[contact_ref(k, true)] = end_snap(eb, j, moment_b, acting, flags);
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -174,13 +177,28 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
+    // Manifolds that bounce the body the same way each ask for the whole
+    // bounce: summed, a box landing across four boxes that stay got four
+    // times its bounce (11 m/s after hitting them at 14, restitution 0.2).
+    // So a bouncing manifold's change is added only as far as the changes
+    // added before it fall short of it along its own direction: bounces the
+    // same way count as the largest of them, bounces at right angles (a ball
+    // rolling into a wall off the ground) each in full.
+    var bounces = vec3<f32>(0.0);
     // the body's manifolds in pair order (contact_lists)
     for (var e = first; e < end; e = e + 1u) {
         let snap = snap_of(body_pairs[e]);
-        dv = dv + snap.dx;
+        let size = length(snap.dx);
+        if ((snap.flags & SNAP_BOUNCE) != 0u && size > 0.0) {
+            let along = snap.dx / size;
+            bounces = bounces + along * max(size - dot(bounces, along), 0.0);
+        } else {
+            dv = dv + snap.dx;
+        }
         dw = dw + snap.dtheta;
         acting = acting + snap.count;
     }
+    dv = dv + bounces;
     dw = dw / f32(max(acting, 1u));
     if (any(dv != vec3<f32>(0.0)) || any(dw != vec3<f32>(0.0))) {
         let now = pose_velocity(s.disp, s.rot, s.prev_rot);

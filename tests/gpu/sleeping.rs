@@ -280,3 +280,36 @@ fn a_box_landing_across_four_that_stay_bounces_no_more_than_its_restitution() {
         assert!((top.position[1] - 1.5).abs() < 0.02, "the box rests at y = {} (on the four: 1.5)", top.position[1]);
     }
 }
+
+/// The other side of combining bounces: a ball rolling on the ground into
+/// a fixed wall bounces off the wall in full (its manifold with the ground
+/// does not bounce, and bounces at right angles each count whole), where
+/// splitting a bounce among the ends that stay had it leave at a quarter.
+#[test]
+fn a_ball_rolling_into_a_fixed_wall_bounces_back_by_its_restitution() {
+    let mut scene = scenes::stack(1);
+    scene.bodies.clear();
+    let mut ball = sphere_body(0.5, [0.0, 0.5, 0.0]);
+    ball.linear_velocity = [6.0, 0.0, 0.0];
+    ball.restitution = Some(0.8);
+    scene.bodies.push(ball);
+    let mut wall = box_body([0.2, 1.0, 2.0], [3.0, 1.0, 0.0]);
+    wall.fixed = true;
+    scene.bodies.push(wall);
+    let Some(mut w) = world(&scene) else { return };
+    let (mut approach, mut leave) = (0.0f32, 0.0f32);
+    for _ in 0..90 {
+        w.step(1).unwrap();
+        let vx = w.read_state().unwrap()[0].linear_velocity[0];
+        if leave == 0.0 {
+            approach = approach.max(vx);
+        }
+        leave = leave.max(-vx);
+    }
+    eprintln!("ball into the wall at {approach} m/s, back at {leave} m/s (e = 0.8)");
+    assert!(approach > 4.0, "the ball came at {approach} m/s");
+    assert!(
+        leave >= 0.7 * 0.8 * approach && leave <= 1.05 * 0.8 * approach,
+        "the ball left at {leave} m/s after hitting at {approach}"
+    );
+}
