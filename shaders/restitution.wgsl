@@ -13,7 +13,8 @@
 // manifold (restitution_contacts, which writes what it asks of each body to
 // its two EndSnaps in snaps and empties its points' friction budgets); each body sums
 // what its manifolds ask (restitution), the turns split among the contacts
-// that acted as in the solve.
+// that acted as in the solve, the bounces combined by direction (see
+// restitution).
 
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
