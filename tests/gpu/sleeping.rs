@@ -203,8 +203,7 @@ fn a_slept_thirty_row_pyramid_woken_by_a_poke_stays_put() {
 /// pair with a sleeper that no walk listed would let the box fall through.
 #[test]
 fn boxes_dropped_on_a_bed_of_sleepers_land_on_it_wherever_they_fall() {
-    let mut scene = scenes::stack(1);
-    scene.bodies.clear();
+    let mut scene = scenes::stack(0); // the ground alone
     for i in 0..7 {
         for k in 0..7 {
             scene.bodies.push(box_body([0.5; 3], [(i as f32 - 3.0) * 1.02, 0.5, (k as f32 - 3.0) * 1.02]));
@@ -249,8 +248,7 @@ fn boxes_dropped_on_a_bed_of_sleepers_land_on_it_wherever_they_fall() {
 #[test]
 fn a_box_landing_across_four_that_stay_bounces_no_more_than_its_restitution() {
     for fixed in [false, true] {
-        let mut scene = scenes::stack(1);
-        scene.bodies.clear();
+        let mut scene = scenes::stack(0); // the ground alone
         for (x, z) in [(-0.51, -0.51), (0.51, -0.51), (-0.51, 0.51), (0.51, 0.51)] {
             let mut b = box_body([0.5; 3], [x, 0.5, z]);
             b.fixed = fixed;
@@ -263,15 +261,7 @@ fn a_box_landing_across_four_that_stay_bounces_no_more_than_its_restitution() {
         w.step(80).unwrap();
         let before = w.read_state().unwrap();
         assert!(fixed || before[..4].iter().all(|b| b.asleep), "the four should sleep before the box arrives");
-        let (mut approach, mut leave) = (0.0f32, 0.0f32);
-        for _ in 0..40 {
-            w.step(1).unwrap();
-            let vy = w.read_state().unwrap()[4].linear_velocity[1];
-            if leave == 0.0 {
-                approach = approach.max(-vy);
-            }
-            leave = leave.max(vy);
-        }
+        let (approach, leave) = speeds_in_and_out(&mut w, 4, [0.0, -1.0, 0.0], 40);
         eprintln!("fixed {fixed}: hit at {approach} m/s, left at {leave} m/s (e = {e})");
         assert!(approach > 13.0, "the box came at {approach} m/s");
         assert!(leave <= 1.05 * e * approach, "the box left at {leave} m/s after hitting at {approach} (e = {e})");
@@ -287,8 +277,7 @@ fn a_box_landing_across_four_that_stay_bounces_no_more_than_its_restitution() {
 /// splitting a bounce among the ends that stay had it leave at a quarter.
 #[test]
 fn a_ball_rolling_into_a_fixed_wall_bounces_back_by_its_restitution() {
-    let mut scene = scenes::stack(1);
-    scene.bodies.clear();
+    let mut scene = scenes::stack(0); // the ground alone
     let mut ball = sphere_body(0.5, [0.0, 0.5, 0.0]);
     ball.linear_velocity = [6.0, 0.0, 0.0];
     ball.restitution = Some(0.8);
@@ -297,19 +286,27 @@ fn a_ball_rolling_into_a_fixed_wall_bounces_back_by_its_restitution() {
     wall.fixed = true;
     scene.bodies.push(wall);
     let Some(mut w) = world(&scene) else { return };
-    let (mut approach, mut leave) = (0.0f32, 0.0f32);
-    for _ in 0..90 {
-        w.step(1).unwrap();
-        let vx = w.read_state().unwrap()[0].linear_velocity[0];
-        if leave == 0.0 {
-            approach = approach.max(vx);
-        }
-        leave = leave.max(-vx);
-    }
+    let (approach, leave) = speeds_in_and_out(&mut w, 0, [1.0, 0.0, 0.0], 90);
     eprintln!("ball into the wall at {approach} m/s, back at {leave} m/s (e = 0.8)");
     assert!(approach > 4.0, "the ball came at {approach} m/s");
     assert!(
         leave >= 0.7 * 0.8 * approach && leave <= 1.05 * 0.8 * approach,
         "the ball left at {leave} m/s after hitting at {approach}"
     );
+}
+
+/// Steps `steps` times one at a time and returns body `i`'s fastest speed
+/// along `toward` before it first turns back, and its fastest speed back
+/// against it after.
+fn speeds_in_and_out(w: &mut verlet::World, i: usize, toward: [f32; 3], steps: u32) -> (f32, f32) {
+    let (mut approach, mut leave) = (0.0f32, 0.0f32);
+    for _ in 0..steps {
+        w.step(1).unwrap();
+        let v = v3(w.read_state().unwrap()[i].linear_velocity).dot(v3(toward));
+        if leave == 0.0 {
+            approach = approach.max(v);
+        }
+        leave = leave.max(-v);
+    }
+    (approach, leave)
 }
