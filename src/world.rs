@@ -134,14 +134,18 @@ pub struct ContactReport {
     pub pairs: u32,
     /// Most candidate pairs in any step so far.
     pub pairs_max: u32,
-    /// Pairs the list holds; more are dropped (and reported).
+    /// Pairs the list holds now; more are dropped (and reported).
     pub pair_capacity: u32,
     /// Manifolds (pairs with contact points) in the last step.
     pub manifolds: u32,
     /// Most manifolds in any step so far.
     pub manifolds_max: u32,
-    /// Manifolds the pool holds; more are dropped (and reported).
+    /// Manifolds the pool holds now; more are dropped (and reported).
     pub manifold_capacity: u32,
+    /// Whether any step so far wanted more pairs or manifolds than its pool
+    /// held, even once grown (the pools also shrink, so the maxima above
+    /// may exceed today's capacities without any loss).
+    pub dropped: bool,
 }
 
 /// Bytes of the `status` buffer the GPU reports through (16 words; see
@@ -216,9 +220,37 @@ impl std::fmt::Display for Fault {
 impl ContactReport {
     /// Whether any step so far found more pairs or manifolds than fit.
     pub fn overflowed(&self) -> bool {
-        self.pairs_max > self.pair_capacity || self.manifolds_max > self.manifold_capacity
+        self.dropped
     }
 }
+
+/// The pools' use as the host follows it from batch to batch: the GPU's
+/// maxima (`status[1]`, `status[5]`) are cleared after each batch is read,
+/// so that they tell what that batch wanted. Index 0: the pair list, 1: the
+/// manifold pool.
+#[derive(Clone, Copy, Debug, Default)]
+struct PoolWatch {
+    /// Most any step wanted so far.
+    peak: [u32; 2],
+    /// Whether a step wanted more than its pool held, even once grown.
+    dropped: bool,
+    /// Steps in a row whose wants stayed under a quarter of the pool, and
+    /// the most they wanted.
+    quiet_steps: [u64; 2],
+    quiet_most: [u32; 2],
+    /// What to make the pool before the next batch (`World::shrink_pools`).
+    shrink_to: [Option<u64>; 2],
+}
+
+/// A pool that no step of this many in a row filled a quarter of is made
+/// twice what the most of them wanted (and no smaller than at least 64
+/// entries) before the next batch: contact memory follows the need down as
+/// well as up, so a pile that has settled and sleeps (no contacts between
+/// sleepers) holds little more than its bodies. Twice the need sits midway
+/// between the quarter and the three quarters that grow it again.
+pub const SHRINK_AFTER_STEPS: u64 = 120;
+/// The fewest entries a pool is made with.
+const MIN_POOL: u64 = 64;
 
 /// Candidate pairs the list holds per body at first (pairs a body owns; see
 /// shaders/pairs.wgsl). A settled pile of cubes
@@ -242,8 +274,8 @@ pub const MANIFOLDS_PER_BODY: u64 = 3;
 pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
     let binding = binding_limit(gpu);
     let by_dispatch = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
-    let pairs = n.saturating_mul(PAIRS_PER_BODY).max(64).min(binding / std::mem::size_of::<Pair>() as u64).min(by_dispatch);
-    let manifolds = n.saturating_mul(MANIFOLDS_PER_BODY).max(64).min(binding / std::mem::size_of::<ContactManifold>() as u64);
+    let pairs = n.saturating_mul(PAIRS_PER_BODY).max(MIN_POOL).min(binding / std::mem::size_of::<Pair>() as u64).min(by_dispatch);
+    let manifolds = n.saturating_mul(MANIFOLDS_PER_BODY).max(MIN_POOL).min(binding / std::mem::size_of::<ContactManifold>() as u64);
     (pairs, manifolds)
 }
 
@@ -301,6 +333,8 @@ pub struct World {
     input: Option<input::InputGpu>,
     /// The scene as loaded or last edited (`edit.rs` rebuilds from it).
     scene: Scene,
+    /// How full the contact pools got (`World::fit_pools`).
+    pools: PoolWatch,
 }
 
 impl World {
@@ -424,6 +458,7 @@ impl World {
             dt_prev: substep_dt,
             input: None,
             scene: scene.clone(),
+            pools: PoolWatch::default(),
         })
     }
 
@@ -481,9 +516,10 @@ impl World {
         let substeps = self.settings.substeps as usize;
         let per_batch = (MAX_BATCH / substeps).max(1);
         for chunk in dts.chunks(per_batch) {
+            self.shrink_pools()?;
             let start = self.batch_start();
             self.encode_and_submit(chunk, substeps);
-            while self.fit_pools()? {
+            while self.fit_pools(chunk.len())? {
                 self.restore_batch_start(start);
                 self.encode_and_submit(chunk, substeps);
             }
@@ -514,19 +550,20 @@ impl World {
     /// Grows the pair list and the manifold pool, before the next step, to
     /// 1.5 times the most a step used once a step has used more than three
     /// quarters of either (a 64-byte blocking readback of the status words
-    /// after every batch of steps). Growing to twice that once a step used
-    /// half held pile-10k's settled contacts in 1862 bytes a body, 1432 so;
-    /// a batch that overflows is taken again, so a tight pool costs time
+    /// after every batch of `steps` steps). Growing to twice that once a step
+    /// used half held pile-10k's settled contacts in 1862 bytes a body, 1432
+    /// so; a batch that overflows is taken again, so a tight pool costs time
     /// only when contacts grow by a third within one batch (none in the
-    /// bench's piles). Both are
-    /// rebuilt every step, so nothing is carried over. Returns whether a
-    /// step of the last batch wanted more than a pool held and the pool has
-    /// grown: which pairs or manifolds then found no room depended on thread
-    /// timing, so the caller takes the batch again. A pool already at its
-    /// binding's limit stays, and its overflow is reported by
-    /// `contact_report`.
-    fn fit_pools(&mut self) -> Result<bool, Error> {
-        let report = self.contact_report()?;
+    /// bench's piles). Both are rebuilt every step, so nothing is carried
+    /// over. Returns whether a step of the last batch wanted more than a pool
+    /// held and the pool has grown: which pairs or manifolds then found no
+    /// room depended on thread timing, so the caller takes the batch again.
+    /// A pool already at its binding's limit stays, and its overflow is
+    /// reported by `contact_report`. Otherwise the batch stands: its wants
+    /// are added to `pools`, which may mark a pool to shrink
+    /// (`SHRINK_AFTER_STEPS`), and the GPU's maxima are cleared for the next.
+    fn fit_pools(&mut self, steps: usize) -> Result<bool, Error> {
+        let report = self.batch_report()?;
         let (most_pairs, most_manifolds) = pair_capacities(&self.gpu, u64::MAX);
         let want = |used: u32, capacity: u32, most: u64| {
             let grown = (3 * used as u64 / 2).max(capacity as u64).min(most);
@@ -534,9 +571,58 @@ impl World {
         };
         let pairs = want(report.pairs_max, report.pair_capacity, most_pairs);
         let manifolds = want(report.manifolds_max, report.manifold_capacity, most_manifolds);
-        if pairs.is_none() && manifolds.is_none() {
-            return Ok(false);
+        if pairs.is_some() || manifolds.is_some() {
+            let (pairs, manifolds) =
+                (pairs.unwrap_or(report.pair_capacity as u64), manifolds.unwrap_or(report.manifold_capacity as u64));
+            self.make_pools(pairs, manifolds, true)?;
+            if report.dropped && report.pairs_max as u64 <= pairs && report.manifolds_max as u64 <= manifolds {
+                return Ok(true);
+            }
         }
+        // the batch stands
+        let watch = &mut self.pools;
+        let wanted = [report.pairs_max, report.manifolds_max];
+        let capacity = [report.pair_capacity, report.manifold_capacity];
+        watch.dropped |= report.dropped;
+        for k in 0..2 {
+            watch.peak[k] = watch.peak[k].max(wanted[k]);
+            if 4 * wanted[k] as u64 >= capacity[k] as u64 {
+                watch.quiet_steps[k] = 0;
+                watch.quiet_most[k] = 0;
+                continue;
+            }
+            watch.quiet_steps[k] += steps as u64;
+            watch.quiet_most[k] = watch.quiet_most[k].max(wanted[k]);
+            let to = (2 * watch.quiet_most[k] as u64).max(MIN_POOL);
+            if watch.quiet_steps[k] >= SHRINK_AFTER_STEPS && to < capacity[k] as u64 {
+                watch.shrink_to[k] = Some(to);
+            }
+        }
+        self.gpu.queue.write_buffer(&self.data.status, 4, bytemuck::bytes_of(&0u32));
+        self.gpu.queue.write_buffer(&self.data.status, 20, bytemuck::bytes_of(&0u32));
+        Ok(false)
+    }
+
+    /// Makes the pools `fit_pools` marked smaller, before a batch: no copy,
+    /// since the batch rebuilds them (and nothing reads them before it).
+    fn shrink_pools(&mut self) -> Result<(), Error> {
+        let [pairs, manifolds] = std::mem::take(&mut self.pools.shrink_to);
+        if pairs.is_none() && manifolds.is_none() {
+            return Ok(());
+        }
+        let (pair_capacity, manifold_capacity) = self.capacities();
+        self.make_pools(pairs.unwrap_or(pair_capacity as u64), manifolds.unwrap_or(manifold_capacity as u64), false)?;
+        self.pools.quiet_steps = [0; 2];
+        self.pools.quiet_most = [0; 2];
+        Ok(())
+    }
+
+    /// Makes the pair list (with the bodies' lists) and the manifold pool
+    /// (with its snaps) hold `pairs` and `manifolds` where they differ from
+    /// today's, copying the old contents over when `keep` (so that
+    /// `read_contacts` still reads the last step's contacts).
+    fn make_pools(&mut self, pairs: u64, manifolds: u64, keep: bool) -> Result<(), Error> {
+        let (pair_capacity, manifold_capacity) = self.capacities();
         let device = &self.gpu.device;
         let storage = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -546,29 +632,32 @@ impl World {
                 mapped_at_creation: false,
             })
         };
-        // the last step's pairs and manifolds are copied over, so that
-        // `read_contacts` still reads them
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("grow pools") });
-        let mut grow = |old: &mut wgpu::Buffer, label: &str, size: u64| {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("resize pools") });
+        let mut remake = |old: &mut wgpu::Buffer, label: &str, size: u64| {
             let new = storage(label, size);
-            encoder.copy_buffer_to_buffer(old, 0, &new, 0, old.size());
+            if keep {
+                encoder.copy_buffer_to_buffer(old, 0, &new, 0, old.size().min(size));
+            }
             *old = new;
         };
-        if let Some(n) = pairs {
-            grow(&mut self.data.pairs, "pairs", n * std::mem::size_of::<Pair>() as u64);
-            grow(&mut self.data.body_pairs, "pairs/body_lists", 2 * n * 4);
+        if pairs != pair_capacity as u64 {
+            remake(&mut self.data.pairs, "pairs", pairs * std::mem::size_of::<Pair>() as u64);
+            remake(&mut self.data.body_pairs, "pairs/body_lists", 2 * pairs * 4);
         }
-        if let Some(n) = manifolds {
-            grow(&mut self.data.manifolds, "manifolds", n * std::mem::size_of::<ContactManifold>() as u64);
-            grow(&mut self.data.snaps, "manifolds/snaps", n * 2 * std::mem::size_of::<EndSnap>() as u64);
+        if manifolds != manifold_capacity as u64 {
+            remake(&mut self.data.manifolds, "manifolds", manifolds * std::mem::size_of::<ContactManifold>() as u64);
+            remake(&mut self.data.snaps, "manifolds/snaps", manifolds * 2 * std::mem::size_of::<EndSnap>() as u64);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines.layout));
         self.gpu.check()?;
-        let grown_past = |wanted: u32, grown: Option<u64>| grown.is_some_and(|n| wanted as u64 <= n);
-        Ok(report.overflowed()
-            && (report.pairs_max <= report.pair_capacity || grown_past(report.pairs_max, pairs))
-            && (report.manifolds_max <= report.manifold_capacity || grown_past(report.manifolds_max, manifolds)))
+        Ok(())
+    }
+
+    /// The pair list's and the manifold pool's capacities now.
+    fn capacities(&self) -> (u32, u32) {
+        let size = |b: &wgpu::Buffer, each: usize| (b.size() / each as u64) as u32;
+        (size(&self.data.pairs, std::mem::size_of::<Pair>()), size(&self.data.manifolds, std::mem::size_of::<ContactManifold>()))
     }
 
     /// Writes one Params slot per substep of `dts`.
@@ -795,6 +884,7 @@ impl World {
         let timer = timestamps.then(|| crate::gpu::PassTimer::new(&gpu, "profile", passes));
         let mut step = 0;
         while step < steps {
+            self.shrink_pools()?;
             let start = self.batch_start();
             let before = totals;
             let dt = [self.settings.dt];
@@ -831,7 +921,7 @@ impl World {
                 }
             }
             self.finish_steps(&dt, substeps);
-            if self.fit_pools()? {
+            if self.fit_pools(1)? {
                 // a pool overflowed: the step is taken again (as step_with
                 // does), its first timing dropped
                 self.restore_batch_start(start);
@@ -878,16 +968,29 @@ impl World {
 
     /// How full the pair list and the manifold pool got (a blocking readback).
     pub fn contact_report(&self) -> Result<ContactReport, Error> {
+        let batch = self.batch_report()?;
+        Ok(ContactReport {
+            pairs_max: batch.pairs_max.max(self.pools.peak[0]),
+            manifolds_max: batch.manifolds_max.max(self.pools.peak[1]),
+            dropped: batch.dropped || self.pools.dropped,
+            ..batch
+        })
+    }
+
+    /// The status words' report: the maxima since `fit_pools` last cleared
+    /// them (the last batch, or the one under way).
+    fn batch_report(&self) -> Result<ContactReport, Error> {
         let bytes = self.gpu.read_buffer(&self.data.status, STATUS_BYTES)?;
         let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        let size = |b: &wgpu::Buffer, each: usize| (b.size() / each as u64) as u32;
+        let (pair_capacity, manifold_capacity) = self.capacities();
         Ok(ContactReport {
             pairs: v[0],
             pairs_max: v[1],
-            pair_capacity: size(&self.data.pairs, std::mem::size_of::<Pair>()),
+            pair_capacity,
             manifolds: v[4],
             manifolds_max: v[5],
-            manifold_capacity: size(&self.data.manifolds, std::mem::size_of::<ContactManifold>()),
+            manifold_capacity,
+            dropped: v[1] > pair_capacity || v[5] > manifold_capacity,
         })
     }
 

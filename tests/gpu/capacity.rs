@@ -166,3 +166,48 @@ fn a_new_world_holds_at_least_the_per_body_estimate() {
     let Some(w) = crate::common::world(&scene) else { return };
     assert!(w.gpu_bytes() >= (verlet::world::bytes_per_body() - 20) * 1000, "{} bytes", w.gpu_bytes());
 }
+
+/// The pools follow the need down as well as up: fifty boxes apart, no
+/// gravity, never touch; once no step of `SHRINK_AFTER_STEPS` wanted a
+/// quarter of either pool, both shrink to the least. Restoring a snapshot
+/// of the same boxes placed at one point then wants 1225 manifolds: the
+/// pools grow, the batch is taken again, and the step comes out bit for
+/// bit as it does in a world made crowded.
+#[test]
+fn the_pools_shrink_while_nothing_touches_and_grow_again_without_a_loss() {
+    use verlet::world::SHRINK_AFTER_STEPS;
+    let mut scene = scenes::stack(0);
+    scene.ground = None;
+    scene.settings.gravity = [0.0; 3];
+    scene.bodies = (0..50).map(|_| box_body([0.5; 3], [0.0, 3.0, 0.0])).collect();
+    let bits = |w: &World| bytemuck::cast_slice::<_, u8>(&w.read_raw().unwrap()).to_vec();
+    let Some(mut crowded) = crate::common::world(&scene) else { return };
+    let start = crowded.snapshot().unwrap();
+    crowded.step(1).unwrap();
+    let grown = crowded.contact_report().unwrap();
+    let after_one = bits(&crowded);
+
+    for (k, b) in scene.bodies.iter_mut().enumerate() {
+        b.position = [2.0 * (k % 10) as f32, 3.0, 2.0 * (k / 10) as f32];
+    }
+    let mut w = crate::common::world(&scene).unwrap();
+    let made = w.contact_report().unwrap();
+    let bytes_made = w.gpu_bytes();
+    w.step(SHRINK_AFTER_STEPS - 30).unwrap();
+    assert_eq!(w.contact_report().unwrap().manifold_capacity, made.manifold_capacity, "shrunk too soon");
+    w.step(60).unwrap();
+    let shrunk = w.contact_report().unwrap();
+    let bytes_shrunk = w.gpu_bytes();
+    eprintln!("crowded {grown:?}\napart, made {made:?} ({bytes_made} B)\nthen {shrunk:?} ({bytes_shrunk} B)");
+    assert!(grown.manifolds >= 1225 && !grown.overflowed(), "{grown:?}");
+    assert!(made.manifold_capacity > 64 && made.pair_capacity > 64, "{made:?}");
+    assert_eq!((shrunk.pair_capacity, shrunk.manifold_capacity, shrunk.manifolds_max), (64, 64, 0), "{shrunk:?}");
+    let freed = (made.pair_capacity - 64) as u64 * (8 + 2 * 4) + (made.manifold_capacity - 64) as u64 * (160 + 64);
+    assert_eq!(bytes_made - bytes_shrunk, freed, "gpu_bytes does not follow the pools");
+    w.restore(&start).unwrap();
+    w.step(1).unwrap();
+    let again = w.contact_report().unwrap();
+    eprintln!("restored crowded, one step: {again:?}");
+    assert!(again.manifold_capacity >= 1225 && again.manifolds_max >= 1225 && !again.overflowed(), "{again:?}");
+    assert!(bits(&w) == after_one, "the step taken on shrunk pools differs from the crowded world's");
+}
