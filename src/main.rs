@@ -91,6 +91,10 @@ struct BenchArgs {
     /// rapier's num_solver_iterations (default: rapier's own, 4).
     #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     rapier_iterations: Option<usize>,
+    /// Most steps the largest pile case of at most 10k bodies takes to come to
+    /// rest, with sleeping on, for the memory of a settled pile (default 1800; 0: not settled).
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
+    settle_steps: Option<u64>,
 }
 
 #[derive(clap::Args)]
@@ -235,6 +239,7 @@ fn bench(a: BenchArgs) -> Result<(), verlet::Error> {
         no_peer: a.no_peer,
         peer_max_bodies: a.peer_max_bodies,
         rapier_sleeping: a.rapier_sleeping,
+        settle_steps: a.settle_steps,
         rapier_iterations: a.rapier_iterations,
         command: std::env::args().collect::<Vec<_>>().join(" "),
     })?;
@@ -776,7 +781,20 @@ fn info() -> Result<(), Error> {
     println!("max buffer size:            {} bytes", l.max_buffer_size);
     println!("max storage buffers/stage:  {}", l.max_storage_buffers_per_shader_stage);
     println!("max workgroups/dimension:   {}", l.max_compute_workgroups_per_dimension);
-    println!("GPU memory per body:        {} bytes", verlet::world::bytes_per_body());
+    use verlet::world::MANIFOLDS_PER_BODY;
+    use verlet::world::{body_bytes, bytes_per_body, manifold_bytes, pair_bytes, PAIRS_PER_BODY, SHRINK_AFTER_STEPS};
+    println!(
+        "GPU memory per body:        {} bytes as a world is made: {} its own, {} its share of the contact pools ({PAIRS_PER_BODY} pairs, {MANIFOLDS_PER_BODY} manifolds)",
+        bytes_per_body(),
+        body_bytes(),
+        bytes_per_body() - body_bytes()
+    );
+    println!(
+        "contact pools:              {} bytes a pair, {} a manifold, by need: grown when a step fills three quarters, \
+         made twice the need when {SHRINK_AFTER_STEPS} steps in a row fill less than a quarter (sleepers hold none)",
+        pair_bytes(),
+        manifold_bytes()
+    );
     println!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu));
     Ok(())
 }

@@ -279,25 +279,37 @@ pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
     (pairs, manifolds)
 }
 
-/// Bytes of GPU memory per body: poses (two buffers), properties, velocities,
-/// the pair list (pairs, the bodies' lists of them, their bookkeeping), the
-/// manifold pool with its snaps, the grid's share (sorted list, about two
-/// hash buckets with their counts and starts), and the copy of the pose and
-/// the pair bookkeeping a batch of steps starts from.
+/// Bytes of GPU memory per body as a world is made: its own share
+/// (`body_bytes`) and its share of the contact pools at their first size
+/// (`PAIRS_PER_BODY` pairs and `MANIFOLDS_PER_BODY` manifolds). The pools
+/// then follow the need (`World::fit_pools`): a settled pile that sleeps
+/// holds little more than `body_bytes`.
 pub fn bytes_per_body() -> u64 {
+    body_bytes() + PAIRS_PER_BODY * pair_bytes() + MANIFOLDS_PER_BODY * manifold_bytes()
+}
+
+/// Bytes of GPU memory a body holds whatever it touches: poses (two
+/// buffers), properties, velocities, its pair bookkeeping, the grid's share
+/// (sorted list, about two hash buckets with their counts and starts), and
+/// the copy of the pose and the pair bookkeeping a batch of steps starts
+/// from.
+pub fn body_bytes() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
     let meta = std::mem::size_of::<PairMeta>() as u64;
-    let pairs = PAIRS_PER_BODY * (std::mem::size_of::<Pair>() as u64 + 2 * 4) + meta;
-    let manifolds = MANIFOLDS_PER_BODY * (std::mem::size_of::<ContactManifold>() + 2 * std::mem::size_of::<EndSnap>()) as u64;
     let grid = 4 + 2 * 8;
     let batch_start = state + meta;
-    2 * state
-        + std::mem::size_of::<BodyProps>() as u64
-        + std::mem::size_of::<Velocity>() as u64
-        + pairs
-        + manifolds
-        + grid
-        + batch_start
+    2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + meta + grid + batch_start
+}
+
+/// Bytes a candidate pair takes: its entry in the pair list and in its two
+/// bodies' lists.
+pub fn pair_bytes() -> u64 {
+    std::mem::size_of::<Pair>() as u64 + 2 * 4
+}
+
+/// Bytes a manifold takes: its slot in the pool and its two snaps.
+pub fn manifold_bytes() -> u64 {
+    (std::mem::size_of::<ContactManifold>() + 2 * std::mem::size_of::<EndSnap>()) as u64
 }
 
 /// The host's side of where a batch of steps started (`World::batch_start`).
