@@ -25,7 +25,7 @@ struct BodyState {
     pos: vec3<f32>,      // centre of mass (m)
     rest_time: f32,      // seconds at rest (see `asleep`)
     disp: vec3<f32>,     // x_n - x_(n-1): how far the centre moved over the last substep (m)
-    pos_low: u32,        // bits 0-29: pos's rounding remainder (`pos_remainder`); bit 31: HELD
+    pos_low: u32,        // bits 0-29: pos's rounding remainder (`pos_remainder`); bit 30: WAKES; bit 31: HELD
     rot: vec4<f32>,      // orientation, unit quaternion
     prev_rot: vec4<f32>, // orientation one step ago
 }
@@ -46,10 +46,11 @@ fn pos_remainder(s: BodyState) -> vec3<f32> {
     return (vec3<f32>(q) - 512.0) * remainder_unit(s.pos);
 }
 
-// pos_low for a remainder r (m) of the position x, with the HELD bit of `flags`.
+// pos_low for a remainder r (m) of the position x, with the HELD and WAKES
+// bits of `flags`.
 fn pack_remainder(r: vec3<f32>, x: vec3<f32>, flags: u32) -> u32 {
     let q = vec3<u32>(vec3<i32>(clamp(round(r / remainder_unit(x)), vec3<f32>(-511.0), vec3<f32>(511.0))) + 512);
-    return q.x | (q.y << 10u) | (q.z << 20u) | (flags & HELD);
+    return q.x | (q.y << 10u) | (q.z << 20u) | (flags & (HELD | WAKES));
 }
 
 // What rarely changes: shape, mass and material. 64 bytes.
@@ -156,8 +157,9 @@ const SUPPORT_ONE: f32 = 32767.0;
 
 // Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
 // how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of
-// both, the cursor its incoming pairs are counted and listed by, its wake
-// flags (WOKEN_*), whether contacts can move it this step (MOVES, SLEEPS,
+// both, the cursor its incoming pairs are counted and listed by, whether
+// the narrowphase found it woken (WOKEN_NOW; integrate moves it to the
+// pose's WAKES bit), whether contacts can move it this step (MOVES, SLEEPS,
 // STAYS_FIXED), how many of its
 // pairs have a manifold (contact_lists: its list then starts with their
 // contact references, see `contact_ref`), and its bounds: the half extents
@@ -190,10 +192,11 @@ const MOVES: u32 = 1u;
 const SLEEPS: u32 = 2u;
 const STAYS_FIXED: u32 = 0u;
 
-// pair_meta[i].woken bits, WOKEN_NOW and WOKEN_LAST (shared with Rust,
-// whose snapshots keep them): set by the narrowphase when an awake partner
-// wakes a sleeper; moved to WOKEN_LAST by integrate, which wakes the body
-// one step later, once the pair list holds all of its pairs again.
+// pair_meta[i].woken's WOKEN_NOW (shared with Rust, whose snapshots keep
+// it): set by the narrowphase when an awake partner wakes a sleeper; moved
+// by integrate to the pose's WAKES bit (pos_low bit 30, shared with Rust),
+// which wakes the body one step later, once the pair list holds all of its
+// pairs again.
 
 // A body's reference to one of its manifolds, as contact_lists leaves it in
 // the body's list: the manifold's index and which end of it the body is.

@@ -79,7 +79,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let reach = reach_of(i);
     let fixed = is_fixed(props[i]);
-    let moves = !fixed && (!asleep(state_in[i]) || atomicLoad(&pair_meta[i].woken) != 0u);
+    let moves = !fixed && (!asleep(state_in[i]) || (state_in[i].pos_low & WAKES) != 0u);
     let sleeps = !fixed && !moves;
     pair_meta[i].moves = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here

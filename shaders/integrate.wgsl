@@ -25,21 +25,25 @@
 // of the body pushed in the substep); a sleeper wakes when an awake body in
 // a pair with it moves faster than WAKE_SPEED at any point or lies more
 // than WAKE_DEPTH inside it (`wakes`, found by the narrowphase; the body
-// wakes one step later, see `woken`); inputs and
+// wakes one step later, see `wakes_next`); inputs and
 // edits wake every body (input.wgsl's wake_all). Box2D's rule is alike (it
 // sleeps whole islands; this sleeps bodies, and a body's awake partners
 // treat it as fixed).
 
-// Whether body i wakes in this substep: only in a step's first substep, one
-// step after the narrowphase found an awake partner waking it (WOKEN_NOW,
-// moved to WOKEN_LAST here), so that this step's pair list already holds
-// all of its pairs (pairs.wgsl lists a woken sleeper's pairs as a mover's).
-fn woken(i: u32) -> bool {
-    let first = params.substep == 0u;
-    let flags = atomicLoad(&pair_meta[i].woken);
-    // later substeps store the flags unchanged (nothing else writes them now)
-    atomicStore(&pair_meta[i].woken, select(flags, select(0u, WOKEN_LAST, (flags & WOKEN_NOW) != 0u), first));
-    return select(false, (flags & WOKEN_LAST) != 0u, first);
+// A body wakes in a step's first substep, one step after the narrowphase
+// found an awake partner waking it (WOKEN_NOW, moved here to the pose's
+// WAKES bit), so that this step's pair list already holds all of its pairs
+// (pairs.wgsl lists a woken sleeper's pairs as a mover's). The WAKES bit
+// body i's pose carries out of this substep: in the first, the
+// narrowphase's finding (cleared for the next step's); in the others, as
+// it came in.
+fn wakes_next(i: u32, s: BodyState) -> u32 {
+    if (params.substep != 0u) {
+        return s.pos_low & WAKES;
+    }
+    let now = atomicLoad(&pair_meta[i].woken);
+    atomicStore(&pair_meta[i].woken, 0u);
+    return select(0u, WAKES, (now & WOKEN_NOW) != 0u);
 }
 
 // Beyond these a body is absurd (m, m/s, rad/s, rad per substep). A pose
@@ -137,7 +141,8 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let s = state_in[i];
     let p = props[i];
     let dt = params.dt;
-    let wake = woken(i);
+    let wake = params.substep == 0u && (s.pos_low & WAKES) != 0u;
+    let wakes = wakes_next(i, s);
     let fault = fault_of(s, p);
     if (fault != NO_FAULT) {
         report_fault(i, fault);
@@ -185,7 +190,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     if (rest >= params.sleep_after && rest > 0.0) {
         // asleep: held still where it is (resting on what pressed it)
-        state_out[i] = BodyState(s.pos, rest, vec3<f32>(0.0), s.pos_low | HELD, s.rot, s.rot);
+        state_out[i] = BodyState(s.pos, rest, vec3<f32>(0.0), (s.pos_low & ~WAKES) | HELD | wakes, s.rot, s.rot);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
@@ -216,6 +221,6 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rot = normalize(quat_mul(turn, s.rot));
     let spin = quat_to_rotvec(turn);
 
-    state_out[i] = BodyState(pos, rest, disp, pack_remainder(dropped, pos, s.pos_low), rot, s.rot);
+    state_out[i] = BodyState(pos, rest, disp, pack_remainder(dropped, pos, (s.pos_low & HELD) | wakes), rot, s.rot);
     vel0[i] = Velocity(vec4<f32>(disp / dt, 0.0), vec4<f32>(spin / dt, 0.0));
 }

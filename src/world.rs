@@ -66,11 +66,12 @@ struct WorldData {
     /// Working buffers of the passes: vel0, and the grid's cell_count,
     /// cell_start, block_sums and sorted.
     scratch: [wgpu::Buffer; 5],
-    /// What a batch of steps starts from (the state, `pair_meta`, whose wake
-    /// flags carry over, and `status`), copied as each batch begins, so that
-    /// a batch during which a pool overflowed is taken again from the same
-    /// start once the pools have grown (`World::step_with`).
-    batch_start: [wgpu::Buffer; 3],
+    /// What a batch of steps starts from (the state and `status`; nothing
+    /// else carries over from one step to the next, see snapshot.rs),
+    /// copied as each batch begins, so that a batch during which a pool
+    /// overflowed is taken again from the same start once the pools have
+    /// grown (`World::step_with`).
+    batch_start: [wgpu::Buffer; 2],
 }
 
 impl WorldData {
@@ -291,14 +292,12 @@ pub fn bytes_per_body() -> u64 {
 /// Bytes of GPU memory a body holds whatever it touches: poses (two
 /// buffers), properties, velocities, its pair bookkeeping, the grid's share
 /// (sorted list, about two hash buckets with their counts and starts), and
-/// the copy of the pose and the pair bookkeeping a batch of steps starts
-/// from.
+/// the copy of the pose a batch of steps starts from.
 pub fn body_bytes() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
     let meta = std::mem::size_of::<PairMeta>() as u64;
     let grid = 4 + 2 * 8;
-    let batch_start = state + meta;
-    2 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + meta + grid + batch_start
+    3 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + meta + grid
 }
 
 /// Bytes a candidate pair takes: its entry in the pair list and in its two
@@ -436,11 +435,7 @@ impl World {
             props: props_buf,
             statics: [large_buf, joint_start, joint_refs],
             scratch: [vel0, cell_count, cell_start, block_sums, sorted],
-            batch_start: [
-                storage("batch start/state", state_bytes),
-                storage("batch start/pairs meta", meta_bytes),
-                storage("batch start/status", STATUS_BYTES),
-            ],
+            batch_start: [storage("batch start/state", state_bytes), storage("batch start/status", STATUS_BYTES)],
         };
         data.bind_groups = Some(data.step_bind_groups(device, &pipelines.layout));
         if !large.is_empty() {
@@ -552,9 +547,8 @@ impl World {
         let BatchStart { current, step, time, dt_prev } = start;
         (self.current, self.step, self.time, self.dt_prev) = (current, step, time, dt_prev);
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("redo batch") });
-        let [state, meta, status] = &self.data.batch_start;
+        let [state, status] = &self.data.batch_start;
         encoder.copy_buffer_to_buffer(state, 0, &self.data.states[current], 0, state.size());
-        encoder.copy_buffer_to_buffer(meta, 0, &self.data.pair_meta, 0, meta.size());
         encoder.copy_buffer_to_buffer(status, 0, &self.data.status, 0, STATUS_BYTES);
         self.gpu.queue.submit([encoder.finish()]);
     }
@@ -728,9 +722,8 @@ impl World {
     /// Records copies of what a batch starts from on the GPU (see
     /// `WorldData::batch_start`).
     fn copy_batch_start(&self, encoder: &mut wgpu::CommandEncoder) {
-        let [state, meta, status] = &self.data.batch_start;
+        let [state, status] = &self.data.batch_start;
         encoder.copy_buffer_to_buffer(&self.data.states[self.current], 0, state, 0, state.size());
-        encoder.copy_buffer_to_buffer(&self.data.pair_meta, 0, meta, 0, meta.size());
         encoder.copy_buffer_to_buffer(&self.data.status, 0, status, 0, STATUS_BYTES);
     }
 

@@ -18,9 +18,9 @@ pub struct BodyState {
     pub disp: [f32; 3],
     /// Bits 0-29: what rounding dropped from `pos` (three signed 10-bit
     /// multiples of 1/512 of each coordinate's f32 spacing, see
-    /// `pos_remainder` in common.wgsl); bit 31 ([`HELD`]): something besides
-    /// gravity held the body over the last substep (a contact, or it is
-    /// fixed or asleep).
+    /// `pos_remainder` in common.wgsl); bit 30 ([`WAKES`]): a sleeper woken,
+    /// due to wake; bit 31 ([`HELD`]): something besides gravity held the
+    /// body over the last substep (a contact, or it is fixed or asleep).
     pub pos_low: u32,
     /// Orientation, unit quaternion (x, y, z, w).
     pub rot: [f32; 4],
@@ -34,6 +34,14 @@ pub struct BodyState {
 /// disp / h as its velocity, without the half substep of gravity that a free
 /// body's disp / h lags by (`World::read_state`).
 pub const HELD: u32 = 0x8000_0000;
+
+/// `BodyState::pos_low` bit 30: the last step's narrowphase found an awake
+/// partner waking this sleeper (`PairMeta::woken`'s `WOKEN_NOW`, moved here
+/// by the step's integration): it wakes in the next step's first substep.
+/// Kept in the pose, which a batch of steps starts from, so that nothing
+/// else carries over from one step to the next (a snapshot's wake flags
+/// call it `WOKEN_LAST`).
+pub const WAKES: u32 = 0x4000_0000;
 
 /// Shape, mass and material of one body (64 bytes), read-only on the GPU.
 #[repr(C)]
@@ -222,9 +230,10 @@ pub struct JointRef {
     pub body: u32,
 }
 
-/// `PairMeta::woken` bits (the same names in WGSL): the narrowphase found an
-/// awake partner waking this sleeper (`WOKEN_NOW`), moved to `WOKEN_LAST`
-/// by the step's integration; the sleeper wakes at the next step.
+/// `PairMeta::woken`: the narrowphase found an awake partner waking this
+/// sleeper (`WOKEN_NOW`, the same name in WGSL), moved to the pose's
+/// [`WAKES`] bit by the step's integration; the sleeper wakes at the next
+/// step. A snapshot's wake flags name the two `WOKEN_NOW` and `WOKEN_LAST`.
 pub const WOKEN_NOW: u32 = 1;
 pub const WOKEN_LAST: u32 = 2;
 

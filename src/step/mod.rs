@@ -215,7 +215,7 @@ impl Stage {
     pub fn reads(self) -> &'static [Buffer] {
         use Buffer::*;
         match self {
-            Stage::GridCount => &[Params, Props, StateIn, CellCount, Status, PairMeta],
+            Stage::GridCount => &[Params, Props, StateIn, CellCount, Status],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, CellStart, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],

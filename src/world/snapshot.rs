@@ -11,9 +11,9 @@
 //! budgets are reset by the integration pass), and the velocities the
 //! restitution pass compares against are written by that step's integration.
 //! One flag outlives a step: a sleeper the narrowphase found woken wakes at
-//! the next step (`pair_meta[i].woken`, see integrate.wgsl). Restoring the
-//! poses, those flags and `dt_prev` therefore continues bit for bit as the
-//! run the snapshot was taken from (tests/gpu/snapshot.rs checks it).
+//! the next step (the pose's `WAKES` bit, see integrate.wgsl). Restoring the
+//! poses and `dt_prev` therefore continues bit for bit as the run the
+//! snapshot was taken from (tests/gpu/snapshot.rs checks it).
 //!
 //! A snapshot names the scene it belongs to by a hash of the world's static
 //! data (settings, ground, grid, the bodies' shapes, masses and materials,
@@ -32,7 +32,7 @@
 //! | 36 | 4 | reserved, 0 |
 //! | 40 | 8 | scene hash (u64) |
 //! | 48 | 64 n | poses: `BodyState` as on the GPU |
-//! | 48 + 64 n | n | each body's wake flags (`PairMeta::woken`: 0, or a sleeper woken) |
+//! | 48 + 64 n | n | each body's wake flags (0, or a sleeper woken: `WOKEN_LAST`, the pose's `WAKES` bit) |
 //! | 48 + 65 n | 8 | FNV-1a 64 of all bytes before it |
 //!
 //! 56 bytes plus 65 bytes per body.
@@ -51,7 +51,7 @@
 use std::path::Path;
 
 use super::World;
-use crate::gpu::types::{BodyProps, BodyState, PairMeta, HELD, WOKEN_LAST, WOKEN_NOW};
+use crate::gpu::types::{BodyProps, BodyState, PairMeta, HELD, WAKES, WOKEN_LAST, WOKEN_NOW};
 use crate::Error;
 
 const MAGIC: &[u8; 8] = b"VRLTSNAP";
@@ -70,8 +70,10 @@ pub struct Snapshot {
     dt_prev: f32,
     scene_hash: u64,
     states: Vec<BodyState>,
-    /// `PairMeta::woken` of every body (0 but for a sleeper woken in the
-    /// last step, which wakes in the next).
+    /// Every body's wake flags: `WOKEN_LAST` for a sleeper woken in the
+    /// last step, which wakes in the next (the pose's `WAKES` bit, also in
+    /// `states`); `WOKEN_NOW`, which no step leaves, is read and restored
+    /// too.
     woken: Vec<u8>,
 }
 
@@ -105,8 +107,8 @@ impl Snapshot {
         &self.states
     }
 
-    /// Every body's wake flags (`PairMeta::woken`): not 0 for a sleeper
-    /// woken in the last step, which wakes in the next.
+    /// Every body's wake flags: not 0 for a sleeper woken in the last step,
+    /// which wakes in the next.
     pub fn woken(&self) -> &[u8] {
         &self.woken
     }
@@ -228,7 +230,12 @@ impl World {
     /// The world's dynamic state (a blocking readback of the current poses).
     pub fn snapshot(&self) -> Result<Snapshot, Error> {
         let states = self.read_raw()?;
-        let woken = self.read_pair_meta()?.iter().take(states.len()).map(|m| m.woken as u8).collect();
+        let now = self.read_pair_meta()?;
+        let woken = states
+            .iter()
+            .zip(&now)
+            .map(|(s, m)| (if s.pos_low & WAKES != 0 { WOKEN_LAST } else { 0 } | m.woken & WOKEN_NOW) as u8)
+            .collect();
         Ok(Snapshot { step: self.step, time: self.time, dt_prev: self.dt_prev, scene_hash: self.scene_hash()?, states, woken })
     }
 
@@ -254,10 +261,21 @@ impl World {
             return Err(Error::Input(format!("snapshot dt_prev {} is not a positive finite number", snapshot.dt_prev)));
         }
         if !snapshot.states.is_empty() {
-            self.gpu.queue.write_buffer(&self.data.states[self.current], 0, bytemuck::cast_slice(&snapshot.states));
+            // the wake flags as the pose's bit (version 2 and older, and
+            // older builds, kept them apart)
+            let states: Vec<BodyState> = snapshot
+                .states
+                .iter()
+                .zip(&snapshot.woken)
+                .map(|(s, &w)| {
+                    let wakes = if u32::from(w) & WOKEN_LAST != 0 { WAKES } else { 0 };
+                    BodyState { pos_low: (s.pos_low & !WAKES) | wakes, ..*s }
+                })
+                .collect();
+            self.gpu.queue.write_buffer(&self.data.states[self.current], 0, bytemuck::cast_slice(&states));
             let mut meta = self.read_pair_meta()?;
             for (m, &w) in meta.iter_mut().zip(&snapshot.woken) {
-                m.woken = u32::from(w);
+                m.woken = u32::from(w) & WOKEN_NOW;
             }
             self.gpu.queue.write_buffer(&self.data.pair_meta, 0, bytemuck::cast_slice(&meta));
         }

@@ -9,10 +9,36 @@ fn bytes(world: &World) -> Vec<u8> {
     bytemuck::cast_slice(&world.read_raw().expect("readback")).to_vec()
 }
 
-fn temp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("verlet-snapshot-{}", std::process::id()));
+/// A file in a temp dir of its own, both removed when dropped: the tests
+/// leave nothing behind.
+struct TempFile(std::path::PathBuf);
+
+impl std::ops::Deref for TempFile {
+    type Target = std::path::Path;
+    fn deref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::path::Path> for TempFile {
+    fn as_ref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+        if let Some(dir) = self.0.parent() {
+            let _ = std::fs::remove_dir(dir);
+        }
+    }
+}
+
+fn temp(name: &str) -> TempFile {
+    let dir = std::env::temp_dir().join(format!("verlet-snapshot-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    TempFile(dir.join(name))
 }
 
 /// Run A: 200 steps straight. Run B: 100 steps, snapshot (through a file
