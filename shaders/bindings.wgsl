@@ -37,7 +37,10 @@
 // status[11]: 1 if a grid body sleeps this step (grid_count sets it,
 // contact_lists clears it: the pair walks read it, see pairs.wgsl);
 // status[12..15]: the contact passes' (workgroups over the manifolds, 1, 1),
-// written by contact_lists and copied out after it; 16 words
+// written by contact_lists and copied out after it; status[15]: 1 if a
+// body moved in the step or is due to wake (integrate sets it, grid_count
+// clears it: with 0 after a batch the world is at rest, and the host skips
+// its steps until an input, see World::at_rest); 16 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1

@@ -65,7 +65,8 @@ fn world_extent(i: u32) -> vec3<f32> {
 
 // Counts body i into its bucket and writes what the pair list reads of it
 // (PairMeta's moves, extent, bound and reach; see pairs.wgsl). Invocation 0
-// also empties the manifold pool's counters (the step's first pass).
+// also empties the manifold pool's counters and the step's "something
+// moves" flag (the step's first pass).
 @compute @workgroup_size(WORKGROUP)
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -73,6 +74,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&status[4], 0u);
         atomicStore(&status[6], 0u);
         atomicStore(&status[7], 0u);
+        atomicStore(&status[15], 0u);
     }
     if (i >= params.body_count) {
         return;

@@ -166,6 +166,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         state_out[i] = BodyState(at, 0.0, vec3<f32>(0.0), 0u, q, q);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
+        atomicStore(&status[15], 1u);
         return;
     }
     if (is_fixed(p)) {
@@ -192,6 +193,9 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         // asleep: held still where it is (resting on what pressed it)
         state_out[i] = BodyState(s.pos, rest, vec3<f32>(0.0), (s.pos_low & ~WAKES) | HELD | wakes, s.rot, s.rot);
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
+        if (wakes != 0u) {
+            atomicStore(&status[15], 1u);
+        }
         return;
     }
     // eq. 11: the last displacement, rescaled to this step's length
@@ -223,4 +227,5 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
 
     state_out[i] = BodyState(pos, rest, disp, pack_remainder(dropped, pos, (s.pos_low & HELD) | wakes), rot, s.rot);
     vel0[i] = Velocity(vec4<f32>(disp / dt, 0.0), vec4<f32>(spin / dt, 0.0));
+    atomicStore(&status[15], 1u);
 }

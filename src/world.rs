@@ -346,6 +346,11 @@ pub struct World {
     scene: Scene,
     /// How full the contact pools got (`World::fit_pools`).
     pools: PoolWatch,
+    /// Nothing moved in the last step taken and no sleeper is due to wake
+    /// (`status[15]`, read by `fit_pools`), and no input, edit or restore
+    /// came since: every body is asleep or fixed, and each step would leave
+    /// every pose as it is, so `step_with` only counts the steps.
+    at_rest: bool,
 }
 
 impl World {
@@ -466,6 +471,7 @@ impl World {
             input: None,
             scene: scene.clone(),
             pools: PoolWatch::default(),
+            at_rest: false,
         })
     }
 
@@ -523,6 +529,10 @@ impl World {
         let substeps = self.settings.substeps as usize;
         let per_batch = (MAX_BATCH / substeps).max(1);
         for chunk in dts.chunks(per_batch) {
+            if self.at_rest {
+                self.finish_steps(chunk, substeps);
+                continue;
+            }
             self.shrink_pools()?;
             let start = self.batch_start();
             self.encode_and_submit(chunk, substeps);
@@ -569,7 +579,8 @@ impl World {
     /// are added to `pools`, which may mark a pool to shrink
     /// (`SHRINK_AFTER_STEPS`), and the GPU's maxima are cleared for the next.
     fn fit_pools(&mut self, steps: usize) -> Result<bool, Error> {
-        let report = self.batch_report()?;
+        let words = self.status_words()?;
+        let report = self.batch_report_of(&words);
         let (most_pairs, most_manifolds) = pair_capacities(&self.gpu, u64::MAX);
         let want = |used: u32, capacity: u32, most: u64| {
             let grown = (3 * used as u64 / 2).max(capacity as u64).min(most);
@@ -606,7 +617,18 @@ impl World {
         }
         self.gpu.queue.write_buffer(&self.data.status, 4, bytemuck::bytes_of(&0u32));
         self.gpu.queue.write_buffer(&self.data.status, 20, bytemuck::bytes_of(&0u32));
+        self.at_rest = words[15] == 0;
         Ok(false)
+    }
+
+    /// Whether the world is at rest: every body asleep or fixed, none due to
+    /// wake, after the last step taken, and no input, edit or restore since.
+    /// Its steps then change no pose, and `step` skips the GPU's work,
+    /// counting only the steps and the time, until an input wakes the
+    /// bodies (a scene that never sleeps, `settings.sleeping` off, is never
+    /// at rest unless every body is fixed).
+    pub fn at_rest(&self) -> bool {
+        self.at_rest
     }
 
     /// Makes the pools `fit_pools` marked smaller, before a batch: no copy,
@@ -838,6 +860,7 @@ impl World {
     /// against a known answer (tests/gpu/kernels.rs), not a way to simulate.
     #[doc(hidden)]
     pub fn run_stages(&mut self, stages: &[Stage]) -> Result<(), Error> {
+        self.at_rest = false;
         self.write_params(&[self.settings.dt], self.settings.substeps as usize);
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stages") });
         for &stage in stages {
@@ -973,7 +996,7 @@ impl World {
 
     /// How full the pair list and the manifold pool got (a blocking readback).
     pub fn contact_report(&self) -> Result<ContactReport, Error> {
-        let batch = self.batch_report()?;
+        let batch = self.batch_report_of(&self.status_words()?);
         Ok(ContactReport {
             pairs_max: batch.pairs_max.max(self.pools.peak[0]),
             manifolds_max: batch.manifolds_max.max(self.pools.peak[1]),
@@ -982,13 +1005,16 @@ impl World {
         })
     }
 
+    /// The status words (a blocking readback; see shaders/bindings.wgsl).
+    fn status_words(&self) -> Result<Vec<u32>, Error> {
+        Ok(bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.status, STATUS_BYTES)?))
+    }
+
     /// The status words' report: the maxima since `fit_pools` last cleared
     /// them (the last batch, or the one under way).
-    fn batch_report(&self) -> Result<ContactReport, Error> {
-        let bytes = self.gpu.read_buffer(&self.data.status, STATUS_BYTES)?;
-        let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+    fn batch_report_of(&self, v: &[u32]) -> ContactReport {
         let (pair_capacity, manifold_capacity) = self.capacities();
-        Ok(ContactReport {
+        ContactReport {
             pairs: v[0],
             pairs_max: v[1],
             pair_capacity,
@@ -996,15 +1022,14 @@ impl World {
             manifolds_max: v[5],
             manifold_capacity,
             dropped: v[1] > pair_capacity || v[5] > manifold_capacity,
-        })
+        }
     }
 
     /// The first numerical fault since the world was made or
     /// [`World::clear_faults`], if any (a 32-byte blocking readback; the
     /// step loop never reads it).
     pub fn faults(&self) -> Result<Option<Fault>, Error> {
-        let bytes = self.gpu.read_buffer(&self.data.status, STATUS_BYTES)?;
-        let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        let v = self.status_words()?;
         Ok(decode_fault(v[2], v[3]))
     }
 

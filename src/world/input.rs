@@ -431,8 +431,10 @@ impl World {
             return Ok(());
         }
         self.ensure_input_gpu(ops.len());
-        // an input adds energy the bodies' speed limits do not count
+        // an input adds energy the bodies' speed limits do not count, and
+        // wakes every body
         self.speed_limits = false;
+        self.at_rest = false;
         let gpu = self.gpu.clone();
         let input = self.input.as_ref().expect("built above");
         gpu.queue.write_buffer(&input.header, 0, bytemuck::bytes_of(header));

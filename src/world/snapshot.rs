@@ -285,6 +285,7 @@ impl World {
         self.dt_prev = snapshot.dt_prev;
         // a snapshot may hold energy the scene did not begin with (inputs)
         self.speed_limits = false;
+        self.at_rest = false;
         Ok(())
     }
 

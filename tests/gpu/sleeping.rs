@@ -310,3 +310,44 @@ fn speeds_in_and_out(w: &mut verlet::World, i: usize, toward: [f32; 3], steps: u
     }
     (approach, leave)
 }
+
+/// A world whose bodies all sleep is at rest: its steps would leave every
+/// pose as it is, so they are counted and skipped. A fresh world restored
+/// from it runs its first batch on the GPU and comes out with the same
+/// bits; an impulse wakes the bodies and the steps run again.
+#[test]
+fn a_world_at_rest_skips_its_steps_until_an_input_wakes_it() {
+    let mut scene = scenes::drop();
+    scene.bodies.push(box_body([0.5; 3], [3.0, 0.5, 0.0]));
+    let bits = |w: &verlet::World| bytemuck::cast_slice::<_, u8>(&w.read_raw().unwrap()).to_vec();
+    let Some(mut w) = world(&scene) else { return };
+    assert!(!w.at_rest(), "a new world is not known to be at rest");
+    let mut steps = 0;
+    while !w.at_rest() {
+        w.step(10).unwrap();
+        steps += 10;
+        assert!(steps <= 600, "the boxes never came to rest");
+    }
+    assert!(w.read_state().unwrap().iter().all(|b| b.asleep), "at rest with a body awake");
+    let (rested, time) = (bits(&w), w.time());
+    let snapshot = w.snapshot().unwrap();
+    w.step(100).unwrap();
+    assert!(w.at_rest());
+    assert_eq!(w.step_count(), steps + 100);
+    assert!((w.time() - time - 100.0 * scene.settings.dt as f64).abs() < 1e-9, "the time did not advance");
+    assert!(bits(&w) == rested, "a pose changed while at rest");
+    // the same 100 steps run on the GPU (the first batch at least): the same bits
+    let mut run = world(&scene).unwrap();
+    run.restore(&snapshot).unwrap();
+    assert!(!run.at_rest());
+    run.step(100).unwrap();
+    assert!(run.at_rest(), "the restored world did not find itself at rest");
+    assert!(bits(&run) == rested, "stepping the resting world moved a pose");
+    // an input wakes it
+    w.apply_impulse(1, [0.0, 5000.0, 0.0], None).unwrap();
+    assert!(!w.at_rest());
+    w.step(1).unwrap();
+    let b = w.read_state().unwrap()[1];
+    assert!(!b.asleep && b.position[1] > 0.52, "the box did not move after the impulse: {b:?}");
+    println!("at rest after {steps} steps");
+}
