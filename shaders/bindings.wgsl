@@ -38,7 +38,7 @@
 // contact_lists clears it: the pair walks read it, see pairs.wgsl);
 // status[12..15]: the contact passes' (workgroups over the manifolds, 1, 1),
 // written by contact_lists and copied out after it; status[15]: 1 if a
-// body moved in the step or is due to wake (integrate sets it, grid_count
+// body moves or is due to wake after the step (integrate sets it, grid_count
 // clears it: with 0 after a batch the world is at rest, and the host skips
 // its steps until an input, see World::at_rest); 16 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
