@@ -262,7 +262,20 @@ pub struct Report {
     /// The largest pile case of at most `SETTLE_MAX_BODIES` bodies, brought
     /// to rest with sleeping on (issue 13's memory target), when measured.
     pub settled: Option<Settled>,
+    /// What a dispatch costs before any work (`dispatch_cost`), when measured.
+    pub dispatch: Option<DispatchCost>,
     pub targets: Vec<Target>,
+}
+
+/// The step's dispatches at the default settings, and what each costs
+/// before any work: ten cubes falling side by side (sleeping off), stepped
+/// 120 times after a first untimed step, the wall clock a step over the
+/// dispatches of a step.
+#[derive(Clone, Debug, Serialize)]
+pub struct DispatchCost {
+    pub dispatches_per_step: usize,
+    pub ten_cubes_ms_per_step: f64,
+    pub us_per_dispatch: f64,
 }
 
 /// A pile stepped until it rests, with sleeping on (the default setting,
@@ -495,6 +508,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     // Rendering comes last: on lavapipe (Mesa 22.3) compute-pass timestamps
     // taken after a render pass on the same device come out near zero, so a
     // render before a profile would corrupt the per-stage table.
+    let dispatch = if profile_steps > 0 { Some(dispatch_cost(&gpu)?) } else { None };
     let render = if profile_steps > 0 { Some(render_cubes(&gpu)?) } else { None };
     let cold_start_s = if profile_steps > 0 { cold_start(if opts.quick { 1 } else { 3 }) } else { Vec::new() };
     let settle_steps = opts.settle_steps.unwrap_or(SETTLE_STEPS);
@@ -531,6 +545,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
         pile_scaling: scaling(&results, "pile"),
         cold_start_s,
         settled,
+        dispatch,
         targets: Vec::new(),
         cases: results,
     };
@@ -547,6 +562,25 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
 }
 
 /// Renders the 1000-cube scene after 60 steps at 640 x 480: (set-up s, ms per frame).
+fn dispatch_cost(gpu: &Arc<Gpu>) -> Result<DispatchCost, Error> {
+    let mut scene = scenes::cubes(10, SEED);
+    // asleep, the world would come to rest and skip its steps
+    scene.settings.sleeping = false;
+    let mut world = World::with_gpu(gpu.clone(), &scene)?;
+    world.step(1)?;
+    gpu.wait()?;
+    let steps = 120;
+    let t = Instant::now();
+    world.step(steps)?;
+    gpu.wait()?;
+    let ms = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
+    let dispatches = world.step_plan().len();
+    let out =
+        DispatchCost { dispatches_per_step: dispatches, ten_cubes_ms_per_step: ms, us_per_dispatch: ms * 1e3 / dispatches as f64 };
+    progress!("dispatches: {dispatches} a step; 10 cubes step in {ms:.2} ms: {:.0} us a dispatch", out.us_per_dispatch);
+    Ok(out)
+}
+
 fn render_cubes(gpu: &Arc<Gpu>) -> Result<(f64, f64), Error> {
     let scene = case("cubes-1k").scene();
     let mut world = World::with_gpu(gpu.clone(), &scene)?;
@@ -1328,6 +1362,15 @@ pub fn table(r: &Report) -> String {
             runs.join(", ")
         );
     }
+    if let Some(d) = &r.dispatch {
+        let _ = writeln!(
+            s,
+            "\ndispatches: {} a step at the default settings (more with joints); ten cubes falling side by side step in {:.2} ms: about {:.0} us a dispatch before any work",
+            d.dispatches_per_step,
+            d.ten_cubes_ms_per_step,
+            d.us_per_dispatch
+        );
+    }
     if let Some(st) = &r.settled {
         let _ = writeln!(
             s,
@@ -1492,6 +1535,7 @@ mod tests {
             pile_scaling: scaling(&cases, "pile"),
             cold_start_s,
             settled: None,
+            dispatch: None,
             cases,
             targets: Vec::new(),
         }
