@@ -561,7 +561,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     Ok(report)
 }
 
-/// Renders the 1000-cube scene after 60 steps at 640 x 480: (set-up s, ms per frame).
+/// Measures `DispatchCost`.
 fn dispatch_cost(gpu: &Arc<Gpu>) -> Result<DispatchCost, Error> {
     let mut scene = scenes::cubes(10, SEED);
     // asleep, the world would come to rest and skip its steps
@@ -581,6 +581,7 @@ fn dispatch_cost(gpu: &Arc<Gpu>) -> Result<DispatchCost, Error> {
     Ok(out)
 }
 
+/// Renders the 1000-cube scene after 60 steps at 640 x 480: (set-up s, ms per frame).
 fn render_cubes(gpu: &Arc<Gpu>) -> Result<(f64, f64), Error> {
     let scene = case("cubes-1k").scene();
     let mut world = World::with_gpu(gpu.clone(), &scene)?;
@@ -1107,7 +1108,6 @@ fn issue13_targets(report: &Report) -> Vec<Target> {
     out
 }
 
-/// Times `runs` whole processes of this binary running `run --builtin
 /// Brings a pile case (named `case` in the report) to rest with sleeping
 /// on (see `Settled`).
 fn settle(gpu: &Arc<Gpu>, pile: &Case, case: &str, most_steps: u64) -> Result<Settled, Error> {
@@ -1154,6 +1154,7 @@ fn settle(gpu: &Arc<Gpu>, pile: &Case, case: &str, most_steps: u64) -> Result<Se
     Ok(out)
 }
 
+/// Times `runs` whole processes of this binary running `run --builtin
 /// cubes --count 10 --steps 1` with Mesa's shader cache disabled (issue 13's
 /// cold start: every kernel compiled from nothing), each from its start to
 /// its exit (s). Empty, with a warning, if one cannot be run or fails.
