@@ -38,12 +38,11 @@
 // narrowphase's finding (cleared for the next step's); in the others, as
 // it came in.
 fn wakes_next(i: u32, s: BodyState) -> u32 {
-    if (params.substep != 0u) {
-        return s.pos_low & WAKES;
-    }
+    let first = params.substep == 0u;
     let now = atomicLoad(&pair_meta[i].woken);
-    atomicStore(&pair_meta[i].woken, 0u);
-    return select(0u, WAKES, (now & WOKEN_NOW) != 0u);
+    // later substeps store it unchanged (nothing sets it after the narrowphase)
+    atomicStore(&pair_meta[i].woken, select(now, 0u, first));
+    return select(s.pos_low & WAKES, select(0u, WAKES, (now & WOKEN_NOW) != 0u), first);
 }
 
 // Notes that a body moves, or is due to wake, after the step (status[15]:
@@ -51,9 +50,10 @@ fn wakes_next(i: u32, s: BodyState) -> u32 {
 // substep: a body that fell asleep in an earlier one holds still from then
 // on. Loaded first, so that after the first store of a step the other
 // lanes only read (a store per body every substep cost integrate 15% at
-// 10k, an atomic being a loop over the lanes on lavapipe).
+// 10k, an atomic being a loop over the lanes on lavapipe); the substep
+// enters the condition by a select, beside the load (see above).
 fn moved() {
-    if (params.substep + 1u == params.substeps && atomicLoad(&status[15]) == 0u) {
+    if (atomicLoad(&status[15]) < select(0u, 1u, params.substep + 1u == params.substeps)) {
         atomicStore(&status[15], 1u);
     }
 }

@@ -351,6 +351,9 @@ pub struct World {
     /// came since: every body is asleep or fixed, and each step would leave
     /// every pose as it is, so `step_with` only counts the steps.
     at_rest: bool,
+    /// The last step was skipped at rest: it listed no pair (nothing
+    /// moves), whatever the last step taken on the GPU left in the pools.
+    skipped: bool,
 }
 
 impl World {
@@ -472,6 +475,7 @@ impl World {
             scene: scene.clone(),
             pools: PoolWatch::default(),
             at_rest: false,
+            skipped: false,
         })
     }
 
@@ -530,9 +534,16 @@ impl World {
         let per_batch = (MAX_BATCH / substeps).max(1);
         for chunk in dts.chunks(per_batch) {
             if self.at_rest {
+                // what the skipped steps would have listed: nothing moves,
+                // so no pair and no manifold (the pools follow)
+                self.skipped = true;
+                let (pairs, manifolds) = self.capacities();
+                self.note_wants([0, 0], [pairs, manifolds], chunk.len());
+                self.shrink_pools()?;
                 self.finish_steps(chunk, substeps);
                 continue;
             }
+            self.skipped = false;
             self.shrink_pools()?;
             let start = self.batch_start();
             self.encode_and_submit(chunk, substeps);
@@ -597,10 +608,20 @@ impl World {
             }
         }
         // the batch stands
+        self.pools.dropped |= report.dropped;
+        self.note_wants([report.pairs_max, report.manifolds_max], [report.pair_capacity, report.manifold_capacity], steps);
+        self.gpu.queue.write_buffer(&self.data.status, 4, bytemuck::bytes_of(&0u32));
+        self.gpu.queue.write_buffer(&self.data.status, 20, bytemuck::bytes_of(&0u32));
+        self.at_rest = words[15] == 0;
+        Ok(false)
+    }
+
+    /// Adds a batch of `steps` steps that wanted at most `wanted` pairs and
+    /// manifolds of pools of `capacity` to `pools`: the peaks, and whether a
+    /// pool has stayed under a quarter for `SHRINK_AFTER_STEPS` (then it is
+    /// marked to shrink to twice the most those steps wanted).
+    fn note_wants(&mut self, wanted: [u32; 2], capacity: [u32; 2], steps: usize) {
         let watch = &mut self.pools;
-        let wanted = [report.pairs_max, report.manifolds_max];
-        let capacity = [report.pair_capacity, report.manifold_capacity];
-        watch.dropped |= report.dropped;
         for k in 0..2 {
             watch.peak[k] = watch.peak[k].max(wanted[k]);
             if 4 * wanted[k] as u64 >= capacity[k] as u64 {
@@ -615,10 +636,6 @@ impl World {
                 watch.shrink_to[k] = Some(to);
             }
         }
-        self.gpu.queue.write_buffer(&self.data.status, 4, bytemuck::bytes_of(&0u32));
-        self.gpu.queue.write_buffer(&self.data.status, 20, bytemuck::bytes_of(&0u32));
-        self.at_rest = words[15] == 0;
-        Ok(false)
     }
 
     /// Whether the world is at rest: every body asleep or fixed, none due to
@@ -640,8 +657,12 @@ impl World {
         }
         let (pair_capacity, manifold_capacity) = self.capacities();
         self.make_pools(pairs.unwrap_or(pair_capacity as u64), manifolds.unwrap_or(manifold_capacity as u64), false)?;
-        self.pools.quiet_steps = [0; 2];
-        self.pools.quiet_most = [0; 2];
+        for (k, shrunk) in [pairs, manifolds].iter().enumerate() {
+            if shrunk.is_some() {
+                self.pools.quiet_steps[k] = 0;
+                self.pools.quiet_most[k] = 0;
+            }
+        }
         Ok(())
     }
 
@@ -860,7 +881,7 @@ impl World {
     /// against a known answer (tests/gpu/kernels.rs), not a way to simulate.
     #[doc(hidden)]
     pub fn run_stages(&mut self, stages: &[Stage]) -> Result<(), Error> {
-        self.at_rest = false;
+        (self.at_rest, self.skipped) = (false, false);
         self.write_params(&[self.settings.dt], self.settings.substeps as usize);
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stages") });
         for &stage in stages {
@@ -912,6 +933,7 @@ impl World {
         let timer = timestamps.then(|| crate::gpu::PassTimer::new(&gpu, "profile", passes));
         let mut step = 0;
         while step < steps {
+            self.skipped = false;
             self.shrink_pools()?;
             let start = self.batch_start();
             let before = totals;
@@ -997,7 +1019,10 @@ impl World {
     /// How full the pair list and the manifold pool got (a blocking readback).
     pub fn contact_report(&self) -> Result<ContactReport, Error> {
         let batch = self.batch_report_of(&self.status_words()?);
+        let last = |n: u32| if self.skipped { 0 } else { n };
         Ok(ContactReport {
+            pairs: last(batch.pairs),
+            manifolds: last(batch.manifolds),
             pairs_max: batch.pairs_max.max(self.pools.peak[0]),
             manifolds_max: batch.manifolds_max.max(self.pools.peak[1]),
             dropped: batch.dropped || self.pools.dropped,
@@ -1046,6 +1071,9 @@ impl World {
     /// and debugging).
     pub fn read_contacts(&self) -> Result<Vec<Vec<BodyContact>>, Error> {
         let n = self.body_count as usize;
+        if self.skipped {
+            return Ok(vec![Vec::new(); n]);
+        }
         let read = |b: &wgpu::Buffer| self.gpu.read_buffer(b, b.size());
         let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&read(&self.data.pair_meta)?);
         let lists: Vec<u32> = bytemuck::pod_collect_to_vec(&read(&self.data.body_pairs)?);

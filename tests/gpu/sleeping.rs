@@ -312,13 +312,14 @@ fn speeds_in_and_out(w: &mut verlet::World, i: usize, toward: [f32; 3], steps: u
 }
 
 /// A world whose bodies all sleep is at rest: its steps would leave every
-/// pose as it is, so they are counted and skipped. A fresh world restored
-/// from it runs its first batch on the GPU and comes out with the same
-/// bits; an impulse wakes the bodies and the steps run again.
+/// pose as it is, so they are counted and skipped, as listing no contacts
+/// (the pools shrink as if they had run). A fresh world restored from it
+/// runs its first batch on the GPU and comes out with the same bits; an
+/// impulse wakes the bodies and the steps run again.
 #[test]
 fn a_world_at_rest_skips_its_steps_until_an_input_wakes_it() {
     let mut scene = scenes::drop();
-    scene.bodies.push(box_body([0.5; 3], [3.0, 0.5, 0.0]));
+    scene.bodies.extend((1..30).map(|k| box_body([0.5; 3], [3.0 * k as f32, 0.5, 0.0])));
     let bits = |w: &verlet::World| bytemuck::cast_slice::<_, u8>(&w.read_raw().unwrap()).to_vec();
     let Some(mut w) = world(&scene) else { return };
     assert!(!w.at_rest(), "a new world is not known to be at rest");
@@ -331,16 +332,24 @@ fn a_world_at_rest_skips_its_steps_until_an_input_wakes_it() {
     assert!(w.read_state().unwrap().iter().all(|b| b.asleep), "at rest with a body awake");
     let (rested, time) = (bits(&w), w.time());
     let snapshot = w.snapshot().unwrap();
-    w.step(100).unwrap();
+    let pools = w.contact_report().unwrap();
+    w.step(verlet::world::SHRINK_AFTER_STEPS + 30).unwrap();
+    let skipped = verlet::world::SHRINK_AFTER_STEPS + 30;
     assert!(w.at_rest());
-    assert_eq!(w.step_count(), steps + 100);
-    assert!((w.time() - time - 100.0 * scene.settings.dt as f64).abs() < 1e-9, "the time did not advance");
+    assert_eq!(w.step_count(), steps + skipped);
+    assert!((w.time() - time - skipped as f64 * scene.settings.dt as f64).abs() < 1e-9, "the time did not advance");
     assert!(bits(&w) == rested, "a pose changed while at rest");
-    // the same 100 steps run on the GPU (the first batch at least): the same bits
+    let report = w.contact_report().unwrap();
+    eprintln!("at rest: {pools:?}\nafter {skipped} steps skipped: {report:?}");
+    assert_eq!((report.pairs, report.manifolds), (0, 0), "skipped steps list no contacts");
+    assert!(w.read_contacts().unwrap().iter().all(|c| c.is_empty()));
+    assert!(pools.manifold_capacity > 64, "{pools:?}");
+    assert_eq!((report.pair_capacity, report.manifold_capacity), (64, 64), "the pools did not follow the skipped steps");
+    // the same steps run on the GPU (the first batch at least): the same bits
     let mut run = world(&scene).unwrap();
     run.restore(&snapshot).unwrap();
     assert!(!run.at_rest());
-    run.step(100).unwrap();
+    run.step(skipped).unwrap();
     assert!(run.at_rest(), "the restored world did not find itself at rest");
     assert!(bits(&run) == rested, "stepping the resting world moved a pose");
     // an input wakes it
