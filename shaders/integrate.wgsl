@@ -36,12 +36,18 @@
 // (pairs.wgsl lists a woken sleeper's pairs as a mover's). The WAKES bit
 // body i's pose carries out of this substep: in the first, the
 // narrowphase's finding (cleared for the next step's); in the others, as
-// it came in.
+// it came in. Only a sleeper can have been found woken (wake_check tests
+// the same pose this substep starts from), so an awake body touches no
+// flag: two atomics a body every substep, each a loop over the lanes on
+// lavapipe.
 fn wakes_next(i: u32, s: BodyState) -> u32 {
     let first = params.substep == 0u;
-    let now = atomicLoad(&pair_meta[i].woken);
-    // later substeps store it unchanged (nothing sets it after the narrowphase)
-    atomicStore(&pair_meta[i].woken, select(now, 0u, first));
+    var now = 0u;
+    if (asleep(s)) {
+        now = atomicLoad(&pair_meta[i].woken);
+        // later substeps store it unchanged (nothing sets it after the narrowphase)
+        atomicStore(&pair_meta[i].woken, select(now, 0u, first));
+    }
     return select(s.pos_low & WAKES, select(0u, WAKES, (now & WOKEN_NOW) != 0u), first);
 }
 
