@@ -501,6 +501,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
             b.position[1]
         );
     }
+    if world.at_rest() {
+        println!("at rest: every body asleep or fixed; steps from then on change nothing and were counted, not run");
+    }
     Ok(())
 }
 

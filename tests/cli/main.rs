@@ -8,3 +8,4 @@ mod common;
 mod cli_capacity;
 mod cli_frames;
 mod cli_hostile;
+mod cli_run;
