@@ -537,8 +537,7 @@ impl World {
                 // what the skipped steps would have listed: nothing moves,
                 // so no pair and no manifold (the pools follow)
                 self.skipped = true;
-                let (pairs, manifolds) = self.capacities();
-                self.note_wants([0, 0], [pairs, manifolds], chunk.len());
+                self.note_wants([0, 0], chunk.len());
                 self.shrink_pools()?;
                 self.finish_steps(chunk, substeps);
                 continue;
@@ -609,7 +608,7 @@ impl World {
         }
         // the batch stands
         self.pools.dropped |= report.dropped;
-        self.note_wants([report.pairs_max, report.manifolds_max], [report.pair_capacity, report.manifold_capacity], steps);
+        self.note_wants([report.pairs_max, report.manifolds_max], steps);
         self.gpu.queue.write_buffer(&self.data.status, 4, bytemuck::bytes_of(&0u32));
         self.gpu.queue.write_buffer(&self.data.status, 20, bytemuck::bytes_of(&0u32));
         self.at_rest = words[15] == 0;
@@ -617,10 +616,12 @@ impl World {
     }
 
     /// Adds a batch of `steps` steps that wanted at most `wanted` pairs and
-    /// manifolds of pools of `capacity` to `pools`: the peaks, and whether a
-    /// pool has stayed under a quarter for `SHRINK_AFTER_STEPS` (then it is
+    /// manifolds to `pools`: the peaks, and whether a pool (as it is now, grown
+    /// or not) has stayed under a quarter for `SHRINK_AFTER_STEPS` (then it is
     /// marked to shrink to twice the most those steps wanted).
-    fn note_wants(&mut self, wanted: [u32; 2], capacity: [u32; 2], steps: usize) {
+    fn note_wants(&mut self, wanted: [u32; 2], steps: usize) {
+        let (pairs, manifolds) = self.capacities();
+        let capacity = [pairs, manifolds];
         let watch = &mut self.pools;
         for k in 0..2 {
             watch.peak[k] = watch.peak[k].max(wanted[k]);
