@@ -12,8 +12,9 @@
 // the block totals of a prefix sum (grid.wgsl's scan): x for the grid, xy for the pairs
 @group(0) @binding(7) var<storage, read_write> block_sums: array<vec2<u32>>;
 // the grid's bodies sorted by cell, then (the last large_count entries,
-// written once when the world is made) the bodies kept out of the grid
-@group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // body_count
+// written once when the world is made) the bodies kept out of the grid;
+// from body_count on, the step's listed bodies (see `listed_body`)
+@group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // 2 x body_count
 // the pair pipeline (pairs.wgsl, narrowphase.wgsl): candidate pairs, each
 // found once; the manifold pool, filled by need; each body's pair list,
 // body i's at body_pairs[pair_meta[i].list_start ..][.. pair_meta[i].total],
@@ -40,11 +41,44 @@
 // written by contact_lists and copied out after it; status[15]: 1 if a
 // body moves or is due to wake after the step (integrate sets it, grid_count
 // clears it: with 0 after a batch the world is at rest, and the host skips
-// its steps until an input, see World::at_rest); 16 words
+// its steps until an input, see World::at_rest); status[16]: how many
+// bodies the step's body passes run over (`listed_body`), or ALL_BODIES;
+// status[17..20]: their indirect dispatch (workgroups over them, 1, 1),
+// counted by contact_lists and copied out after it; 20 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1
 @group(0) @binding(14) var<storage, read> joint_refs: array<JointRef>;          // 2 per joint
+
+// The body that invocation k of a body pass (integrate, solve,
+// restitution) works on, or NONE (past the body count): the k-th body
+// contact_lists listed this step, in sorted[body_count ..] (status[16] of
+// them), or body k where no list was made (status[16] = ALL_BODIES: a
+// world not yet stepped, World::run_stages without contact_lists). Every
+// body is listed but a sleeper that the step leaves as it is (see
+// `sleeps_held` in narrowphase.wgsl): its pose is then the same in both
+// state buffers, as every pass would have copied it, and a resting pile
+// with a few bodies awake pays these passes for the few. The list's order
+// depends on thread timing, but each body's result depends on its own data
+// alone.
+fn listed_body(k: u32) -> u32 {
+    let listed = atomicLoad(&status[16]);
+    if (listed == ALL_BODIES) {
+        return k;
+    }
+    return select(NONE, sorted[params.body_count + k], k < listed);
+}
+
+// Lists body i for the body passes (contact_lists, see `listed_body`): at
+// the next place of sorted's second half, counting one more workgroup of
+// their indirect dispatch (status[17]) with each place that starts one.
+fn list_body(i: u32) {
+    let k = atomicAdd(&status[16], 1u);
+    sorted[params.body_count + k] = i;
+    if (k % WORKGROUP == 0u) {
+        atomicAdd(&status[17], 1u);
+    }
+}
 
 // The k-th body kept out of the grid (its index).
 fn large_body(k: u32) -> u32 {

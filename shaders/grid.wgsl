@@ -75,6 +75,9 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&status[6], 0u);
         atomicStore(&status[7], 0u);
         atomicStore(&status[15], 0u);
+        // contact_lists lists the bodies and counts their workgroups
+        atomicStore(&status[16], 0u);
+        atomicStore(&status[17], 0u);
     }
     if (i >= params.body_count) {
         return;

@@ -152,7 +152,7 @@ fn opaque(v: vec3<f32>) -> vec3<f32> {
 // 2-3 ms a dispatch (a 10-cube step went from 3.2 to 12 ms).
 @compute @workgroup_size(WORKGROUP)
 fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
+    let i = listed_body(gid.x);
     if (i >= params.body_count) {
         return;
     }

@@ -301,6 +301,9 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     pair_meta[i].contacts = end - first;
     var held = 0u;
     var movers = 0.0;
+    // a manifold narrowphase_clip still has to clip, with a partner that
+    // moves: its clipping may wake the body
+    var may_wake = false;
     let w = props[i].inv_inertia.w;
     for (var k = first; k < end; k = k + 1u) {
         let r = body_pairs[k];
@@ -309,11 +312,30 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         held = held + u32(stays);
         if (!stays) {
             movers = movers + w / max(w + props[partner].inv_inertia.w, 1e-30);
+            may_wake = may_wake || manifolds[r >> 1u].clip_face != NONE;
         }
     }
     pair_meta[i].held = held;
     let jointed = is_jointed(i);
     pair_meta[i].normal_split = select(1.0, max(1.0, params.relaxation * (f32(held) + movers)), held > 0u && !jointed);
+    // the bodies the step may change, for the body passes (`listed_body`
+    // in bindings.wgsl): all but the sleepers held still that nothing woke
+    // and that narrowphase_clip cannot wake (listing a sleeper that stays
+    // asleep changes nothing: integrate holds it, the others copy it)
+    if (!sleeps_held(i) || atomicLoad(&pair_meta[i].woken) != 0u || may_wake) {
+        list_body(i);
+    }
+}
+
+// Whether body i is a sleeper the step leaves as it is unless something
+// wakes it: pair_meta's SLEEPS (not due to wake), held as integrate holds a
+// sleeper (no displacement, no turn, HELD), so that integrate would write
+// back what it reads and the other passes copy it; not on a joint
+// (solve_joints shares rest times within an island, in place).
+fn sleeps_held(i: u32) -> bool {
+    let s = state_in[i];
+    let held = all(s.disp == vec3<f32>(0.0)) && all(s.prev_rot == s.rot) && (s.pos_low & HELD) != 0u;
+    return pair_meta[i].moves == SLEEPS && held && !is_jointed(i);
 }
 
 // Where contact reference r goes in its body's list: pairs the body does not

@@ -41,9 +41,11 @@ fn end_velocity(i: u32, e: ContactEnd) -> Velocity {
     return pose_velocity(e.disp, e.rot, e.prev_rot);
 }
 
-// ... and before it (integrate's vel0).
-fn end_velocity_before(i: u32) -> Velocity {
-    if (i == GROUND) {
+// ... and before it (integrate's vel0): zero for an end the contacts may
+// not move, as integrate writes for a fixed body or a sleeper (a sleeper
+// the step leaves as it is is not integrated, see `listed_body`).
+fn end_velocity_before(i: u32, e: ContactEnd) -> Velocity {
+    if (!e.moves) {
         return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
     }
     return vel0[i];
@@ -67,8 +69,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         return;
     }
-    let va0 = end_velocity_before(a);
-    let vb0 = end_velocity_before(b);
+    let va0 = end_velocity_before(a, ea);
+    let vb0 = end_velocity_before(b, eb);
     let va = end_velocity(a, ea);
     let vb = end_velocity(b, eb);
     let threshold = max(2.0 * length(params.gravity) * params.dt, RESTITUTION_THRESHOLD);
@@ -163,7 +165,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 @compute @workgroup_size(WORKGROUP)
 fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
+    let i = listed_body(gid.x);
     if (i >= params.body_count) {
         return;
     }

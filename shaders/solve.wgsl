@@ -248,7 +248,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 @compute @workgroup_size(WORKGROUP)
 fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
+    let i = listed_body(gid.x);
     if (i >= params.body_count) {
         return;
     }

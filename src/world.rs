@@ -149,9 +149,9 @@ pub struct ContactReport {
     pub dropped: bool,
 }
 
-/// Bytes of the `status` buffer the GPU reports through (16 words; see
+/// Bytes of the `status` buffer the GPU reports through (20 words; see
 /// shaders/bindings.wgsl, binding 12).
-const STATUS_BYTES: u64 = 64;
+const STATUS_BYTES: u64 = 80;
 /// `status[2]` and `status[3]` before any fault (`NO_FAULT` in integrate.wgsl).
 pub const NO_FAULT: u32 = u32::MAX;
 /// The speed (m/s) and distance from the origin (m) beyond which a body's
@@ -271,12 +271,18 @@ pub const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 pub const MANIFOLDS_PER_BODY: u64 = 3;
 
 /// The pair list's and the manifold pool's sizes for `n` bodies on `gpu`:
-/// per body as above, within one storage binding and one dispatch.
+/// per body as above, within one storage binding and one dispatch (the
+/// passes over them are dispatched indirectly, and wgpu's check of an
+/// indirect dispatch's size is off: see `Gpu::new`).
 pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
     let binding = binding_limit(gpu);
     let by_dispatch = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
     let pairs = n.saturating_mul(PAIRS_PER_BODY).max(MIN_POOL).min(binding / std::mem::size_of::<Pair>() as u64).min(by_dispatch);
-    let manifolds = n.saturating_mul(MANIFOLDS_PER_BODY).max(MIN_POOL).min(binding / std::mem::size_of::<ContactManifold>() as u64);
+    let manifolds = n
+        .saturating_mul(MANIFOLDS_PER_BODY)
+        .max(MIN_POOL)
+        .min(binding / std::mem::size_of::<ContactManifold>() as u64)
+        .min(by_dispatch);
     (pairs, manifolds)
 }
 
@@ -291,12 +297,13 @@ pub fn bytes_per_body() -> u64 {
 
 /// Bytes of GPU memory a body holds whatever it touches: poses (two
 /// buffers), properties, velocities, its pair bookkeeping, the grid's share
-/// (sorted list, about two hash buckets with their counts and starts), and
+/// (sorted list, about two hash buckets with their counts and starts), its
+/// place in the list of bodies the body passes run over, and
 /// the copy of the pose a batch of steps starts from.
 pub fn body_bytes() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
     let meta = std::mem::size_of::<PairMeta>() as u64;
-    let grid = 4 + 2 * 8;
+    let grid = 2 * 4 + 2 * 8;
     3 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + meta + grid
 }
 
@@ -402,7 +409,8 @@ impl World {
         let cell_start = storage("grid/cell_start", 4 * (hash + 1));
         // block totals of the grid's scan and the pairs' (xy)
         let block_sums = storage("scan/block_sums", 8 * hash.max(count as u64).div_ceil(SCAN_SPAN as u64));
-        let sorted = storage("grid/sorted", 4 * count as u64);
+        // the grid's order, then the step's listed bodies (`listed_body` in bindings.wgsl)
+        let sorted = storage("grid/sorted", 8 * count as u64);
         let large_buf = with_data("grid/large", bytemuck::cast_slice(&large));
         let (pair_capacity, manifold_capacity) = pair_capacities(&gpu, count as u64);
         let pairs = storage("pairs", pair_capacity * std::mem::size_of::<Pair>() as u64);
@@ -415,7 +423,7 @@ impl World {
         let status = with_data("status", bytemuck::cast_slice(&STATUS_INIT));
         let dispatch = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("indirect dispatches"),
-            size: 32,
+            size: 48,
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -568,7 +576,11 @@ impl World {
         (self.current, self.step, self.time, self.dt_prev) = (current, step, time, dt_prev);
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("redo batch") });
         let [state, status] = &self.data.batch_start;
-        encoder.copy_buffer_to_buffer(state, 0, &self.data.states[current], 0, state.size());
+        // into both state buffers: a body the step leaves as it is holds the
+        // same in both (`listed_body` in bindings.wgsl)
+        for to in &self.data.states {
+            encoder.copy_buffer_to_buffer(state, 0, to, 0, state.size());
+        }
         encoder.copy_buffer_to_buffer(status, 0, &self.data.status, 0, STATUS_BYTES);
         self.gpu.queue.submit([encoder.finish()]);
     }
@@ -817,7 +829,10 @@ impl World {
     fn copy_dispatch_sizes(&self, encoder: &mut wgpu::CommandEncoder, stage: Stage, before: bool) {
         match (stage, before) {
             (Stage::Narrowphase, true) => encoder.copy_buffer_to_buffer(&self.data.status, 32, &self.data.dispatch, 0, 12),
-            (Stage::ContactLists, false) => encoder.copy_buffer_to_buffer(&self.data.status, 48, &self.data.dispatch, 16, 12),
+            (Stage::ContactLists, false) => {
+                encoder.copy_buffer_to_buffer(&self.data.status, 48, &self.data.dispatch, 16, 12);
+                encoder.copy_buffer_to_buffer(&self.data.status, 68, &self.data.dispatch, 32, 12);
+            }
             _ => {}
         }
     }
@@ -833,6 +848,7 @@ impl World {
         match stage.over() {
             Over::Pairs => pass.dispatch_workgroups_indirect(&self.data.dispatch, 0),
             Over::Manifolds => pass.dispatch_workgroups_indirect(&self.data.dispatch, 16),
+            Over::Listed => pass.dispatch_workgroups_indirect(&self.data.dispatch, 32),
             over => pass.dispatch_workgroups(self.workgroups(over), 1, 1),
         }
         if stage.flips_state() {
@@ -884,6 +900,13 @@ impl World {
     pub fn run_stages(&mut self, stages: &[Stage]) -> Result<(), Error> {
         (self.at_rest, self.skipped) = (false, false);
         self.write_params(&[self.settings.dt], self.settings.substeps as usize);
+        if !stages.contains(&Stage::ContactLists) {
+            // no list of bodies: the body passes run over all of them
+            let queue = &self.gpu.queue;
+            queue.write_buffer(&self.data.status, 16 * 4, bytemuck::bytes_of(&ALL_BODIES));
+            let all = [self.workgroups(Over::Bodies), 1, 1];
+            queue.write_buffer(&self.data.dispatch, 32, bytemuck::cast_slice(&all));
+        }
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stages") });
         for &stage in stages {
             self.encode_pass(&mut encoder, stage, 0, None);
@@ -996,7 +1019,7 @@ impl World {
             Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_SPAN),
             Over::One => 1,
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
-            Over::Pairs | Over::Manifolds => unreachable!("dispatched indirectly"),
+            Over::Pairs | Over::Manifolds | Over::Listed => unreachable!("dispatched indirectly"),
         };
         n.max(1)
     }
@@ -1137,8 +1160,10 @@ impl World {
 }
 
 /// The status words as made: pair and manifold counts 0 (maxima
-/// atomicMax-ed), no fault (atomicMin-ed), the rest spare.
-const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] = [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0];
+/// atomicMax-ed), no fault (atomicMin-ed), no list of bodies yet (the body
+/// passes run over all), the rest spare.
+const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] =
+    [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, ALL_BODIES, 0, 1, 1];
 
 /// The damping per substep that removes `beta` per step: 1 - (1 - beta)^(1/n).
 fn per_substep(beta: f32, substeps: usize) -> f32 {

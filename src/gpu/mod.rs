@@ -120,7 +120,16 @@ impl Gpu {
         // wgpu skips names it does not know, and with none left finds no
         // adapter at all: say which variable is wrong instead
         check_env()?;
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        // wgpu checks the size of every indirect dispatch on the GPU before
+        // it runs, with a dispatch of its own: 14 a step at the defaults, 40
+        // us each on lavapipe (pile-1k stepped 11% faster without). The
+        // step's sizes are within max_compute_workgroups_per_dimension by
+        // construction (the pools' capacities, `pair_capacities`; the listed
+        // bodies, `max_bodies`), so the check is off unless
+        // WGPU_VALIDATION_INDIRECT_CALL=1 asks for it.
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+        descriptor.flags.remove(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
+        let instance = wgpu::Instance::new(descriptor.with_env());
         let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
             Ok(wanted) if !wanted.is_empty() => {
                 let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;

@@ -67,6 +67,10 @@ pub enum Over {
     Manifolds,
     /// The joint islands (see `joint_lists`).
     Islands,
+    /// The bodies the step may change (`listed_body` in bindings.wgsl): an
+    /// indirect dispatch whose size `contact_lists` counted (status[17..20],
+    /// copied to `dispatch` + 32 after it).
+    Listed,
 }
 
 /// The buffers of the step's bind group, by binding (shaders/bindings.wgsl,
@@ -229,12 +233,12 @@ impl Stage {
             Stage::NarrowphaseGround => &[Params, Props, StateIn, Pairs, Status, PairMeta],
             Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
-            Stage::Integrate => &[Params, Props, StateIn, Status, JointStart, PairMeta],
+            Stage::Integrate => &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta],
             Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
-            Stage::Solve => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs, JointStart],
+            Stage::Solve => &[Params, Props, StateIn, Sorted, Snaps, Status, PairMeta, BodyPairs, JointStart],
             Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
             Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status, PairMeta],
-            Stage::Restitution => &[Params, Props, StateIn, Snaps, PairMeta, BodyPairs],
+            Stage::Restitution => &[Params, Props, StateIn, Sorted, Snaps, Status, PairMeta, BodyPairs],
         }
     }
 
@@ -250,7 +254,7 @@ impl Stage {
             Stage::GridSort => &[Sorted],
             Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
             Stage::Narrowphase | Stage::NarrowphaseGround => &[Manifolds, Status, PairMeta, BodyPairs],
-            Stage::ContactLists => &[Status, PairMeta, BodyPairs],
+            Stage::ContactLists => &[Sorted, Status, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Manifolds, PairMeta],
             Stage::Integrate => &[StateOut, Vel0, Status, PairMeta],
             Stage::SolveContacts | Stage::RestitutionContacts => &[Snaps, Manifolds],
@@ -304,6 +308,7 @@ impl Stage {
             Stage::Narrowphase => Over::Pairs,
             Stage::NarrowphaseClip | Stage::SolveContacts | Stage::RestitutionContacts => Over::Manifolds,
             Stage::SolveJoints => Over::Islands,
+            Stage::Integrate | Stage::Solve | Stage::Restitution => Over::Listed,
             _ => Over::Bodies,
         }
     }

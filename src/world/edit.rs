@@ -77,7 +77,10 @@ impl World {
             }
         }
         let queue = &world.gpu.queue;
-        queue.write_buffer(&world.data.states[world.current], 0, bytemuck::cast_slice::<BodyState, u8>(&states));
+        // both state buffers, as a world is made (`listed_body` in bindings.wgsl)
+        for to in &world.data.states {
+            queue.write_buffer(to, 0, bytemuck::cast_slice::<BodyState, u8>(&states));
+        }
         queue.write_buffer(&world.data.props, 0, bytemuck::cast_slice::<BodyProps, u8>(&props));
         world.gpu.check()?;
         world.step = self.step;

@@ -272,7 +272,11 @@ impl World {
                     BodyState { pos_low: (s.pos_low & !WAKES) | wakes, ..*s }
                 })
                 .collect();
-            self.gpu.queue.write_buffer(&self.data.states[self.current], 0, bytemuck::cast_slice(&states));
+            // both state buffers: a sleeper the next step leaves as it is is
+            // read from either (`listed_body` in bindings.wgsl)
+            for to in &self.data.states {
+                self.gpu.queue.write_buffer(to, 0, bytemuck::cast_slice(&states));
+            }
             let mut meta = self.read_pair_meta()?;
             for (m, &w) in meta.iter_mut().zip(&snapshot.woken) {
                 m.woken = u32::from(w) & WOKEN_NOW;

@@ -8,6 +8,7 @@
 use crate::common::{v3, world};
 use verlet::scene::{Joint, WORLD};
 use verlet::scenes::{self, box_body, sphere_body};
+use verlet::step::Buffer;
 
 #[test]
 fn a_box_at_rest_falls_asleep_and_then_does_not_move_at_all() {
@@ -359,4 +360,47 @@ fn a_world_at_rest_skips_its_steps_until_an_input_wakes_it() {
     let b = w.read_state().unwrap()[1];
     assert!(!b.asleep && b.position[1] > 0.52, "the box did not move after the impulse: {b:?}");
     println!("at rest after {steps} steps");
+}
+
+/// The body passes (integrate, solve, restitution) run over the bodies a
+/// step may change (`listed_body` in shaders/bindings.wgsl): in a pile half
+/// asleep every awake body is listed, once, and every body left out is a
+/// sleeper whose pose is the same, bit for bit, in both state buffers (what
+/// the passes' copies would have left there); an input wakes and lists all.
+#[test]
+fn the_body_passes_run_over_the_awake_bodies_and_leave_sleepers_alike_in_both_buffers() {
+    let scene = scenes::pile(200, 3);
+    let n = scene.bodies.len();
+    let Some(mut w) = world(&scene) else { return };
+    let mut steps = 0;
+    while w.read_state().unwrap().iter().filter(|b| b.asleep).count() < n / 2 {
+        w.step(30).unwrap();
+        steps += 30;
+        assert!(steps <= 1200, "the pile did not half fall asleep");
+    }
+    let listed = |w: &verlet::World| {
+        let count = w.read_words(Buffer::Status).unwrap()[16] as usize;
+        w.read_words(Buffer::Sorted).unwrap()[n..n + count].to_vec()
+    };
+    let list = listed(&w);
+    let mut once = list.clone();
+    once.sort_unstable();
+    once.dedup();
+    assert_eq!(once.len(), list.len(), "a body listed twice");
+    let bodies = w.read_state().unwrap();
+    let (a, b) = (w.read_words(Buffer::StateIn).unwrap(), w.read_words(Buffer::StateOut).unwrap());
+    let words = std::mem::size_of::<verlet::gpu::types::BodyState>() / 4;
+    for (i, body) in bodies.iter().enumerate() {
+        if once.binary_search(&(i as u32)).is_ok() {
+            continue;
+        }
+        assert!(body.asleep, "body {i} is awake and was left out of the body passes");
+        assert_eq!(a[i * words..(i + 1) * words], b[i * words..(i + 1) * words], "sleeper {i} differs between the state buffers");
+    }
+    let asleep = bodies.iter().filter(|b| b.asleep).count();
+    println!("after {steps} steps: {asleep} of {n} asleep, {} listed", list.len());
+    assert!(list.len() < n, "every body was listed in a pile half asleep");
+    w.apply_impulse(0, [0.0, 100.0, 0.0], None).unwrap();
+    w.step(1).unwrap();
+    assert_eq!(listed(&w).len(), n, "an input wakes every body, and every body is listed");
 }
