@@ -90,12 +90,12 @@ fn manifolds_used() -> u32 {
     return min(atomicLoad(&status[4]), arrayLength(&manifolds));
 }
 
-// The slot of the k-th stored manifold (k < manifolds_used()): the pool
-// fills from both ends (see new_manifold in narrowphase.wgsl), the face
-// contacts left for clipping at the top.
-fn pool_slot(k: u32) -> u32 {
+// The slot of the k-th stored manifold (k < used = manifolds_used()): the
+// pool fills from both ends (see new_manifold in narrowphase.wgsl), the
+// face contacts left for clipping at the top.
+fn pool_slot(k: u32, used: u32) -> u32 {
     let top = min(atomicLoad(&status[6]), arrayLength(&manifolds));
-    let bottom = manifolds_used() - top;
+    let bottom = used - top;
     return select(k, arrayLength(&manifolds) - top + (k - bottom), k >= bottom);
 }
 

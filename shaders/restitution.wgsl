@@ -53,10 +53,11 @@ fn end_velocity_before(i: u32, e: ContactEnd) -> Velocity {
 
 @compute @workgroup_size(WORKGROUP)
 fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= manifolds_used()) {
+    let used = manifolds_used();
+    if (gid.x >= used) {
         return;
     }
-    let k = pool_slot(gid.x);
+    let k = pool_slot(gid.x, used);
     let a = manifolds[k].a;
     let b = manifolds[k].b;
     let ea = contact_end(a);

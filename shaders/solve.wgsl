@@ -115,12 +115,18 @@ fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
 
 @compute @workgroup_size(WORKGROUP)
 fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= manifolds_used()) {
+    let used = manifolds_used();
+    if (gid.x >= used) {
         return;
     }
-    let k = pool_slot(gid.x);
-    var ea = contact_end(manifolds[k].a);
-    var eb = contact_end(manifolds[k].b);
+    let k = pool_slot(gid.x, used);
+    // the header, read once (the pool is written here, so a second read
+    // is a second load: a loop over the lanes on lavapipe)
+    let a = manifolds[k].a;
+    let b = manifolds[k].b;
+    let count = manifolds[k].count;
+    var ea = contact_end(a);
+    var eb = contact_end(b);
     if (!ea.moves && !eb.moves) {
         return; // neither body reads its snap
     }
@@ -139,8 +145,8 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let mu = combined_friction(ea, eb);
     // pushes against an end that stays are split (stay_splits)
     // (x: friction's, y: the normal pushes')
-    let split_a = stay_splits(manifolds[k].a, eb.moves);
-    let split_b = stay_splits(manifolds[k].b, ea.moves);
+    let split_a = stay_splits(a, eb.moves);
+    let split_b = stay_splits(b, ea.moves);
     // summed over the points, for a: normal and friction pushes (b gets the
     // opposite), their moments about each centre, the sums of 1 / w
     var normal_j = vec3<f32>(0.0);
@@ -157,7 +163,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     var old_depth = 0.0;
     var shallow_depth = 0.0;
     var all_depth = 0.0;
-    for (var q = 0u; q < manifolds[k].count; q = q + 1u) {
+    for (var q = 0u; q < count; q = q + 1u) {
         let pt = manifolds[k].points[q];
         let local_a = end_point(ea, pt.local_a, n);
         let local_b = end_point(eb, pt.local_b, -n);
