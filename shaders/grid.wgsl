@@ -176,15 +176,41 @@ fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_
     for (var h = first; h < end; h = h + 1u) {
         scan_write(h, scan_written(h) + before); // exclusive within the block
     }
+    // one block is the whole scan: its offset is 0 and it finishes the
+    // scan itself, so that scan_sums (and the grid's scan_add) need not run
+    // (`World::step_plan` leaves them out)
+    let whole = scan_len() <= SCAN_SPAN;
     if (lid.x == SCAN_BLOCK - 1u) {
-        block_sums[wid.x] = scan_tmp[lid.x];
+        block_sums[wid.x] = select(scan_tmp[lid.x], vec2<u32>(0u), whole);
+    }
+    if ((lid.x == SCAN_BLOCK - 1u) & whole) {
+        finish_scan(scan_tmp[lid.x]);
+    }
+}
+
+// Writes the whole scan's total `sum` past the last entry and, for the
+// pairs, their count and the narrowphase's indirect dispatch.
+fn finish_scan(sum: vec2<u32>) {
+    scan_write(scan_len(), sum);
+    if (SCAN_PAIRS) {
+        // the narrowphase runs over the pairs that fit the list
+        let listed = min(sum.x, arrayLength(&pairs));
+        atomicStore(&status[0], sum.x);
+        atomicMax(&status[1], sum.x);
+        atomicStore(&status[8], (listed + WORKGROUP - 1u) / WORKGROUP);
+        atomicStore(&status[9], 1u);
+        atomicStore(&status[10], 1u);
     }
 }
 
 // One workgroup turns the block totals into exclusive block offsets, each
-// invocation scanning a run of consecutive blocks first.
+// invocation scanning a run of consecutive blocks first (nothing to do for
+// a scan of one block, which scan_blocks finished).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
+    if (scan_len() <= SCAN_SPAN) {
+        return;
+    }
     let blocks = (scan_len() + SCAN_SPAN - 1u) / SCAN_SPAN;
     let run = (blocks + SCAN_BLOCK - 1u) / SCAN_BLOCK;
     let first = lid.x * run;
@@ -205,17 +231,7 @@ fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
         }
     }
     if (lid.x == SCAN_BLOCK - 1u) {
-        let sum = scan_tmp[lid.x];
-        scan_write(scan_len(), sum);
-        if (SCAN_PAIRS) {
-            // the narrowphase runs over the pairs that fit the list
-            let listed = min(sum.x, arrayLength(&pairs));
-            atomicStore(&status[0], sum.x);
-            atomicMax(&status[1], sum.x);
-            atomicStore(&status[8], (listed + WORKGROUP - 1u) / WORKGROUP);
-            atomicStore(&status[9], 1u);
-            atomicStore(&status[10], 1u);
-        }
+        finish_scan(scan_tmp[lid.x]);
     }
 }
 

@@ -860,9 +860,20 @@ impl World {
     /// the broadphase and narrowphase once, then for every substep the
     /// integration, `iterations` sweeps of the solve's two halves and the
     /// restitution's two (the contacts, kept in the bodies' own frames,
-    /// serve all substeps).
+    /// serve all substeps). A scan of at most `SCAN_SPAN` buckets or
+    /// bodies is one block, which its first pass finishes: the grid's
+    /// `grid_scan_sums` and `grid_scan_add` and the pairs' `pairs_scan_sums`
+    /// are then left out (three dispatches fewer up to 1024 bodies).
     pub fn step_plan(&self) -> Vec<(Stage, usize)> {
-        let mut plan: Vec<(Stage, usize)> = Stage::ALL.iter().take_while(|s| **s != Stage::Integrate).map(|&s| (s, 0)).collect();
+        // a scan of one block is finished by its first pass (grid.wgsl)
+        let one_block = |len: u32| len <= SCAN_SPAN;
+        let needed = |s: &Stage| match s {
+            Stage::GridScanSums | Stage::GridScanAdd => !one_block(self.grid.hash_size),
+            Stage::PairsScanSums => !one_block(self.body_count),
+            _ => true,
+        };
+        let mut plan: Vec<(Stage, usize)> =
+            Stage::ALL.iter().take_while(|s| **s != Stage::Integrate).filter(|s| needed(s)).map(|&s| (s, 0)).collect();
         for sub in 0..self.settings.substeps as usize {
             plan.push((Stage::Integrate, sub));
             for _ in 0..self.settings.iterations {

@@ -220,7 +220,7 @@ impl Stage {
         use Buffer::*;
         match self {
             Stage::GridCount => &[Params, Props, StateIn, CellCount, Status],
-            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, CellStart, PairMeta],
+            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, CellStart, Status, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
@@ -247,7 +247,7 @@ impl Stage {
         use Buffer::*;
         match self {
             Stage::GridCount => &[CellCount, Status, PairMeta],
-            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[CellStart, BlockSums, PairMeta],
+            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[CellStart, BlockSums, Status, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[CellStart, BlockSums, Status, PairMeta],
             Stage::GridScanAdd => &[CellStart],
             Stage::GridScatter => &[CellCount, Sorted],
