@@ -42,7 +42,7 @@
 // body moves or is due to wake after the step (integrate sets it, grid_count
 // clears it: with 0 after a batch the world is at rest, and the host skips
 // its steps until an input, see World::at_rest); status[16]: how many
-// bodies the step's body passes run over (`listed_body`), or ALL_BODIES;
+// bodies the step's body passes run over (`listed_body`);
 // status[17..20]: their indirect dispatch (workgroups over them, 1, 1),
 // counted by contact_lists and copied out after it; 20 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
@@ -51,22 +51,18 @@
 @group(0) @binding(14) var<storage, read> joint_refs: array<JointRef>;          // 2 per joint
 
 // The body that invocation k of a body pass (integrate, solve,
-// restitution) works on, or NONE (past the body count): the k-th body
-// contact_lists listed this step, in sorted[body_count ..] (status[16] of
-// them), or body k where no list was made (status[16] = ALL_BODIES: a
-// world not yet stepped, World::run_stages without contact_lists). Every
-// body is listed but a sleeper that the step leaves as it is (see
-// `sleeps_held` in narrowphase.wgsl): its pose is then the same in both
-// state buffers, as every pass would have copied it, and a resting pile
-// with a few bodies awake pays these passes for the few. The list's order
-// depends on thread timing, but each body's result depends on its own data
-// alone.
+// restitution) works on, or NONE: the k-th body contact_lists listed this
+// step, in sorted[body_count ..] (status[16] of them; grid_count fills the
+// rest of the run with NONE, so no invocation reads the count: an atomic
+// load is a loop over the lanes on lavapipe). World::run_stages without
+// contact_lists lists every body itself. Every body is listed but a
+// sleeper that the step leaves as it is (see `sleeps_held` in
+// narrowphase.wgsl): its pose is then the same in both state buffers, as
+// every pass would have copied it, and a resting pile with a few bodies
+// awake pays these passes for the few. The list's order depends on thread
+// timing, but each body's result depends on its own data alone.
 fn listed_body(k: u32) -> u32 {
-    let listed = atomicLoad(&status[16]);
-    if (listed == ALL_BODIES) {
-        return k;
-    }
-    return select(NONE, sorted[params.body_count + k], k < listed);
+    return select(NONE, sorted[params.body_count + k], k < params.body_count);
 }
 
 // Lists body i for the body passes (contact_lists, see `listed_body`): at

@@ -82,6 +82,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
+    sorted[params.body_count + i] = NONE; // no body listed here yet
     let reach = reach_of(i);
     let fixed = is_fixed(props[i]);
     let moves = !fixed && (!asleep(state_in[i]) || (state_in[i].pos_low & WAKES) != 0u);

@@ -912,9 +912,15 @@ impl World {
         (self.at_rest, self.skipped) = (false, false);
         self.write_params(&[self.settings.dt], self.settings.substeps as usize);
         if !stages.contains(&Stage::ContactLists) {
-            // no list of bodies: the body passes run over all of them
+            if stages.contains(&Stage::GridCount) && stages.iter().any(|s| s.over() == Over::Listed) {
+                return Err(Error::Input("run_stages: grid_count empties the list of bodies that contact_lists makes".into()));
+            }
+            // no list made: the body passes run over every body
+            let n = self.body_count;
+            let every: Vec<u32> = (0..n).collect();
             let queue = &self.gpu.queue;
-            queue.write_buffer(&self.data.status, 16 * 4, bytemuck::bytes_of(&ALL_BODIES));
+            queue.write_buffer(&self.data.scratch[4], 4 * n as u64, bytemuck::cast_slice(&every));
+            queue.write_buffer(&self.data.status, 16 * 4, bytemuck::bytes_of(&n));
             let all = [self.workgroups(Over::Bodies), 1, 1];
             queue.write_buffer(&self.data.dispatch, 32, bytemuck::cast_slice(&all));
         }
@@ -1171,10 +1177,8 @@ impl World {
 }
 
 /// The status words as made: pair and manifold counts 0 (maxima
-/// atomicMax-ed), no fault (atomicMin-ed), no list of bodies yet (the body
-/// passes run over all), the rest spare.
-const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] =
-    [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, ALL_BODIES, 0, 1, 1];
+/// atomicMax-ed), no fault (atomicMin-ed), the rest spare.
+const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] = [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1];
 
 /// The damping per substep that removes `beta` per step: 1 - (1 - beta)^(1/n).
 fn per_substep(beta: f32, substeps: usize) -> f32 {

@@ -20,7 +20,6 @@ pub fn shared_constants() -> String {
     let mut out = String::from("// Shared with Rust: written by src/gpu/shaders.rs from the Rust constants.\n");
     let words = [
         ("NONE", NONE),
-        ("ALL_BODIES", ALL_BODIES),
         ("GROUND", GROUND),
         ("WORLD", WORLD),
         ("HELD", HELD),

@@ -247,9 +247,6 @@ pub const GROUND: u32 = u32::MAX;
 pub const MAX_POINTS: u32 = 4;
 /// No pair / no manifold (`NONE` in WGSL).
 pub const NONE: u32 = u32::MAX;
-/// `status[16]` when no list of bodies was made for the body passes: they
-/// run over every body (`ALL_BODIES` in WGSL; `listed_body` in bindings.wgsl).
-pub const ALL_BODIES: u32 = u32::MAX;
 /// Invocations of a scan workgroup (`SCAN_BLOCK` in WGSL).
 pub const SCAN_BLOCK: u32 = 256;
 /// Buckets (or bodies) each invocation of a scan sums in turn (`SCAN_RUN`).

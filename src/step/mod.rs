@@ -235,10 +235,10 @@ impl Stage {
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Integrate => &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta],
             Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
-            Stage::Solve => &[Params, Props, StateIn, Sorted, Snaps, Status, PairMeta, BodyPairs, JointStart],
+            Stage::Solve => &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart],
             Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
             Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status, PairMeta],
-            Stage::Restitution => &[Params, Props, StateIn, Sorted, Snaps, Status, PairMeta, BodyPairs],
+            Stage::Restitution => &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs],
         }
     }
 
@@ -246,7 +246,7 @@ impl Stage {
     pub fn writes(self) -> &'static [Buffer] {
         use Buffer::*;
         match self {
-            Stage::GridCount => &[CellCount, Status, PairMeta],
+            Stage::GridCount => &[CellCount, Sorted, Status, PairMeta],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[CellStart, BlockSums, Status, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[CellStart, BlockSums, Status, PairMeta],
             Stage::GridScanAdd => &[CellStart],
