@@ -8,4 +8,5 @@ mod common;
 mod cli_capacity;
 mod cli_frames;
 mod cli_hostile;
+mod cli_info;
 mod cli_run;
