@@ -329,12 +329,14 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // Whether body i is a sleeper the step leaves as it is unless something
 // wakes it: pair_meta's SLEEPS (not due to wake), held as integrate holds a
-// sleeper (no displacement, no turn, HELD), so that integrate would write
-// back what it reads and the other passes copy it; not on a joint
-// (solve_joints shares rest times within an island, in place).
+// sleeper (no displacement, no turn, HELD; compared bit for bit, as
+// integrate writes them), so that integrate would write back what it reads
+// and the other passes copy it; not on a joint (solve_joints shares rest
+// times within an island, in place).
 fn sleeps_held(i: u32) -> bool {
     let s = state_in[i];
-    let held = all(s.disp == vec3<f32>(0.0)) && all(s.prev_rot == s.rot) && (s.pos_low & HELD) != 0u;
+    let still = all(bitcast<vec3<u32>>(s.disp) == vec3<u32>(0u)) && all(bitcast<vec4<u32>>(s.prev_rot) == bitcast<vec4<u32>>(s.rot));
+    let held = still && (s.pos_low & HELD) != 0u;
     return pair_meta[i].moves == SLEEPS && held && !is_jointed(i);
 }
 
