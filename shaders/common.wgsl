@@ -289,6 +289,18 @@ fn quat_from_rotvec(v: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(v * (sin(h) / angle), cos(h));
 }
 
+// No infinity or NaN (exponent bits all set): WGSL has no isNan, and x != x
+// may be folded away by a driver's fast-math.
+fn all_finite(v: vec4<f32>) -> bool {
+    let exponent = bitcast<vec4<u32>>(v) & vec4<u32>(0x7f800000u);
+    return all(exponent != vec4<u32>(0x7f800000u));
+}
+
+// Finite and within MAX_DISTANCE of the origin (integrate.wgsl's faults).
+fn near(p: vec3<f32>) -> bool {
+    return all_finite(vec4<f32>(p, 0.0)) && dot(p, p) <= MAX_DISTANCE * MAX_DISTANCE;
+}
+
 // Apply a small world-frame rotation dtheta (radians) to q: q' = q + 1/2 (dtheta, 0) q.
 fn quat_add_rotation(q: vec4<f32>, dtheta: vec3<f32>) -> vec4<f32> {
     return normalize(q + 0.5 * quat_mul(vec4<f32>(dtheta, 0.0), q));

@@ -85,16 +85,7 @@ fn moved() {
 // looked like a success. The limit holds only while nothing else added
 // energy (params.speed_limits: 0 after any input, edit or restore).
 
-// No infinity or NaN (exponent bits all set): WGSL has no isNan, and x != x
-// may be folded away by a driver's fast-math.
-fn all_finite(v: vec4<f32>) -> bool {
-    let exponent = bitcast<vec4<u32>>(v) & vec4<u32>(0x7f800000u);
-    return all(exponent != vec4<u32>(0x7f800000u));
-}
-
-fn near(p: vec3<f32>) -> bool {
-    return all_finite(vec4<f32>(p, 0.0)) && dot(p, p) <= MAX_DISTANCE * MAX_DISTANCE;
-}
+// (all_finite and near: common.wgsl)
 
 fn usable_rotation(q: vec4<f32>) -> bool {
     let d = dot(q, q);

@@ -302,8 +302,8 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     var held = 0u;
     var movers = 0.0;
     // a manifold narrowphase_clip still has to clip, with a partner that
-    // moves: its clipping may wake the body
-    var may_wake = false;
+    // moves, may wake the body; so may one its list lost, where it overflowed
+    var may_wake = first + atomicLoad(&pair_meta[i].cursor) > arrayLength(&body_pairs);
     let w = props[i].inv_inertia.w;
     for (var k = first; k < end; k = k + 1u) {
         let r = body_pairs[k];
@@ -331,12 +331,14 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
 // wakes it: pair_meta's SLEEPS (not due to wake), held as integrate holds a
 // sleeper (no displacement, no turn, HELD; compared bit for bit, as
 // integrate writes them), so that integrate would write back what it reads
-// and the other passes copy it; not on a joint (solve_joints shares rest
-// times within an island, in place).
+// and the other passes copy it; sane (finite, within MAX_DISTANCE: such a
+// pose passes integrate's fault checks, and one that would not, restored
+// from a snapshot, is listed so that integrate finds the fault); not on a
+// joint (solve_joints shares rest times within an island, in place).
 fn sleeps_held(i: u32) -> bool {
     let s = state_in[i];
     let still = all(bitcast<vec3<u32>>(s.disp) == vec3<u32>(0u)) && all(bitcast<vec4<u32>>(s.prev_rot) == bitcast<vec4<u32>>(s.rot));
-    let held = still && (s.pos_low & HELD) != 0u;
+    let held = still && (s.pos_low & HELD) != 0u && near(s.pos) && all_finite(s.rot);
     return pair_meta[i].moves == SLEEPS && held && !is_jointed(i);
 }
 

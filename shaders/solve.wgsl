@@ -3,7 +3,8 @@
 // Contacts are relaxed Jacobi style. Every pose is read from state_in:
 // solve_contacts, one invocation per manifold of the pool, measures all of
 // a pair's points once and writes what they ask of each of its two bodies
-// (its two EndSnaps in snaps); solve, one invocation per body, sums what its
+// (its two EndSnaps in snaps); solve, one invocation per listed body
+// (`listed_body` in bindings.wgsl), sums what its
 // manifolds ask, relaxes the sum by c_r (eq. 10) and writes only its own
 // slot of state_out. Joints are then closed in turn, Gauss-Seidel style,
 // by solve_joints (below). All of a body's snaps are

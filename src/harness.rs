@@ -1366,7 +1366,7 @@ pub fn table(r: &Report) -> String {
     if let Some(d) = &r.dispatch {
         let _ = writeln!(
             s,
-            "\ndispatches: {} a step for ten cubes at the default settings (three more above 1024 bodies, more with joints); they step in {:.2} ms: about {:.0} us a dispatch before any work",
+            "\ndispatches: {} a step for ten cubes at the default settings (two more above 1024 bodies, three above 2048, more with joints); they step in {:.2} ms: about {:.0} us a dispatch before any work",
             d.dispatches_per_step,
             d.ten_cubes_ms_per_step,
             d.us_per_dispatch

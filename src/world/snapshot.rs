@@ -5,11 +5,14 @@
 //! taken and restored through the API or a small binary file.
 //!
 //! What carries over from one step to the next is exactly this: every pass
-//! that writes poses writes every body's slot of the other pose buffer, so
-//! the buffer that is not current is overwritten before it is read; the
-//! contact lists are rebuilt by each step's narrowphase (their `pushed`
-//! budgets are reset by the integration pass), and the velocities the
-//! restitution pass compares against are written by that step's integration.
+//! that writes poses writes the other pose buffer's slot of every body it
+//! runs over, so that buffer is overwritten before it is read, and a
+//! sleeper the passes leave out (`listed_body` in shaders/bindings.wgsl)
+//! holds the same pose in both (restoring writes both); the contact lists
+//! are rebuilt by each step's narrowphase (their `pushed` budgets are reset
+//! by the restitution pass), and the velocities the restitution pass
+//! compares against are written by that step's integration for every body
+//! that can move (an end that cannot counts as still).
 //! One flag outlives a step: a sleeper the narrowphase found woken wakes at
 //! the next step (the pose's `WAKES` bit, see integrate.wgsl). Restoring the
 //! poses and `dt_prev` therefore continues bit for bit as the run the

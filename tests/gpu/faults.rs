@@ -153,6 +153,26 @@ fn a_nan_is_flagged_and_the_body_parked_at_its_finite_coordinates() {
     assert!(why.contains("body 3 became non-finite at step 5"), "{why}");
 }
 
+/// A sleeper is checked too, though the body passes leave sleepers held
+/// still out of their list (`listed_body` in bindings.wgsl): one moved
+/// beyond MAX_DISTANCE in place (as a snapshot could bring it) is listed
+/// again, and integrate flags it.
+#[test]
+fn a_sleeper_made_absurd_in_place_is_flagged() {
+    let mut scene = row();
+    scene.bodies[0].position[1] = 20.0; // still falling at step 60: the world is not at rest
+    let Some(mut world) = crate::common::world(&scene) else { return };
+    world.step(60).unwrap();
+    let bodies = world.read_state().unwrap();
+    assert!(bodies[1..].iter().all(|b| b.asleep) && !bodies[0].asleep, "{bodies:?}");
+    let mut far = raw(&world)[3];
+    far.pos[0] = 2e6;
+    let at = 3 * std::mem::size_of::<BodyState>() as u64;
+    world.gpu().queue.write_buffer(world.current_state_buffer(), at, bytemuck::bytes_of(&far));
+    world.step(5).unwrap();
+    assert_eq!(world.faults().unwrap(), Some(Fault { body: 3, step: 60, kind: FaultKind::TooFar }));
+}
+
 #[test]
 fn a_clean_run_of_1000_steps_reports_no_fault() {
     let Some(mut world) = crate::common::world(&scenes::cubes(100, 3)) else { return };
