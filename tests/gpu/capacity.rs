@@ -130,6 +130,18 @@ fn a_body_that_owns_more_pairs_than_its_scratch_room_lists_them_all() {
     }
 }
 
+/// Fifty unit boxes placed at one point 3 m up (1225 touching pairs).
+fn fifty_at_one_point() -> verlet::Scene {
+    let mut scene = scenes::stack(0);
+    scene.bodies = (0..50).map(|_| box_body([0.5; 3], [0.0, 3.0, 0.0])).collect();
+    scene
+}
+
+/// Every bit of a world's poses.
+fn bits(w: &World) -> Vec<u8> {
+    bytemuck::cast_slice::<_, u8>(&w.read_raw().unwrap()).to_vec()
+}
+
 /// A step that wants more pairs or manifolds than the pools hold is taken
 /// again once they have grown: which manifolds found no room depended on
 /// thread timing, so fifty boxes placed at one point (1225 touching pairs,
@@ -137,9 +149,7 @@ fn a_body_that_owns_more_pairs_than_its_scratch_room_lists_them_all() {
 /// flew apart at up to 5700 m/s.
 #[test]
 fn a_step_that_overflows_a_pool_is_taken_again() {
-    let mut scene = scenes::stack(0);
-    scene.bodies = (0..50).map(|_| box_body([0.5; 3], [0.0, 3.0, 0.0])).collect();
-    let bits = |w: &World| bytemuck::cast_slice::<_, u8>(&w.read_raw().unwrap()).to_vec();
+    let scene = fifty_at_one_point();
     let Some(mut batch) = crate::common::world(&scene) else { return };
     let made = batch.contact_report().unwrap();
     batch.step(3).unwrap();
@@ -176,11 +186,9 @@ fn a_new_world_holds_at_least_the_per_body_estimate() {
 #[test]
 fn the_pools_shrink_while_nothing_touches_and_grow_again_without_a_loss() {
     use verlet::world::SHRINK_AFTER_STEPS;
-    let mut scene = scenes::stack(0);
+    let mut scene = fifty_at_one_point();
     scene.ground = None;
     scene.settings.gravity = [0.0; 3];
-    scene.bodies = (0..50).map(|_| box_body([0.5; 3], [0.0, 3.0, 0.0])).collect();
-    let bits = |w: &World| bytemuck::cast_slice::<_, u8>(&w.read_raw().unwrap()).to_vec();
     let Some(mut crowded) = crate::common::world(&scene) else { return };
     let start = crowded.snapshot().unwrap();
     crowded.step(1).unwrap();
