@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use crate::gpu::{types::*, Gpu};
 use crate::scene::{Scene, Settings};
-use crate::step::{Buffer, Over, Stage, StepPipelines, STORAGE_BUFFERS};
+use crate::step::{storage_buffers, Buffer, Over, Stage, StepPipelines};
 use crate::Error;
 
 pub mod edit;
@@ -54,9 +54,9 @@ struct WorldData {
     /// `status` before it, the contact passes' at 16, copied after
     /// `contact_lists`.
     dispatch: wgpu::Buffer,
-    /// `bind_groups[k]` reads `states[k]` and writes `states[1 - k]`
-    /// (always made, right after the buffers).
-    bind_groups: Option<[wgpu::BindGroup; 2]>,
+    /// Each stage's two bind groups, by stage (`step_bind_groups`; always
+    /// made, right after the buffers).
+    bind_groups: Option<Vec<[wgpu::BindGroup; 2]>>,
     /// Shapes, masses and materials (written by the input kernel too).
     props: wgpu::Buffer,
     /// What the scene fixed at start-up: the bodies kept out of the grid
@@ -75,48 +75,58 @@ struct WorldData {
 }
 
 impl WorldData {
-    /// The step's two bind groups (bindings 1..=16 of shaders/bindings.wgsl),
-    /// with state_in and state_out per direction.
-    fn step_bind_groups(&self, device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> [wgpu::BindGroup; 2] {
+    /// The buffer bound at `buffer`'s binding while `states[from]` is the
+    /// current state (state_in) and the other the next (state_out).
+    fn buffer(&self, buffer: Buffer, from: usize) -> &wgpu::Buffer {
         let [vel0, cell_count, cell_start, block_sums, sorted] = &self.scratch;
         let [_, joint_start, joint_refs] = &self.statics;
-        let group = |from: usize| {
-            let buffers: [&wgpu::Buffer; STORAGE_BUFFERS as usize] = [
-                &self.props,
-                &self.states[from],
-                &self.states[1 - from],
-                vel0,
-                cell_count,
-                cell_start,
-                block_sums,
-                sorted,
-                &self.snaps,
-                &self.pairs,
-                &self.manifolds,
-                &self.status,
-                joint_start,
-                joint_refs,
-                &self.pair_meta,
-                &self.body_pairs,
-            ];
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &self.params,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-                }),
-            }];
-            for (k, buf) in buffers.iter().enumerate() {
-                entries.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: buf.as_entire_binding() });
-            }
+        match buffer {
+            Buffer::Params => &self.params,
+            Buffer::Props => &self.props,
+            Buffer::StateIn => &self.states[from],
+            Buffer::StateOut => &self.states[1 - from],
+            Buffer::Vel0 => vel0,
+            Buffer::CellCount => cell_count,
+            Buffer::CellStart => cell_start,
+            Buffer::BlockSums => block_sums,
+            Buffer::Sorted => sorted,
+            Buffer::Snaps => &self.snaps,
+            Buffer::Pairs => &self.pairs,
+            Buffer::Manifolds => &self.manifolds,
+            Buffer::Status => &self.status,
+            Buffer::JointStart => joint_start,
+            Buffer::JointRefs => joint_refs,
+            Buffer::PairMeta => &self.pair_meta,
+            Buffer::BodyPairs => &self.body_pairs,
+        }
+    }
+
+    /// Every stage's two bind groups (its buffers, `Stage::buffers`), by
+    /// stage: `[k]` reads `states[k]` and writes `states[1 - k]`.
+    fn step_bind_groups(&self, device: &wgpu::Device, pipelines: &StepPipelines) -> Vec<[wgpu::BindGroup; 2]> {
+        let group = |stage: Stage, from: usize| {
+            let entries: Vec<wgpu::BindGroupEntry> = stage
+                .buffers()
+                .into_iter()
+                .map(|buffer| {
+                    let b = self.buffer(buffer, from);
+                    // Params: one substep's slot, chosen by the dynamic offset
+                    let size = (buffer == Buffer::Params).then(|| std::mem::size_of::<Params>() as u64);
+                    let resource = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: b,
+                        offset: 0,
+                        size: size.and_then(wgpu::BufferSize::new),
+                    });
+                    wgpu::BindGroupEntry { binding: buffer.binding(), resource }
+                })
+                .collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(if from == 0 { "step A->B" } else { "step B->A" }),
-                layout,
+                label: Some(stage.name()),
+                layout: pipelines.layout(stage),
                 entries: &entries,
             })
         };
-        [group(0), group(1)]
+        Stage::ALL.iter().map(|&stage| [group(stage, 0), group(stage, 1)]).collect()
     }
 }
 
@@ -453,7 +463,7 @@ impl World {
             scratch: [vel0, cell_count, cell_start, block_sums, sorted],
             batch_start: [storage("batch start/state", state_bytes), storage("batch start/status", STATUS_BYTES)],
         };
-        data.bind_groups = Some(data.step_bind_groups(device, &pipelines.layout));
+        data.bind_groups = Some(data.step_bind_groups(device, &pipelines));
         if !large.is_empty() {
             // the grid's part of `sorted` holds the other bodies, n - large of them
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("large bodies") });
@@ -711,7 +721,7 @@ impl World {
             remake(&mut self.data.snaps, "manifolds/snaps", manifolds * 2 * std::mem::size_of::<EndSnap>() as u64);
         }
         self.gpu.queue.submit([encoder.finish()]);
-        self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines.layout));
+        self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines));
         self.gpu.check()?;
         Ok(())
     }
@@ -842,7 +852,7 @@ impl World {
     fn dispatch(&mut self, pass: &mut wgpu::ComputePass<'_>, stage: Stage, slot: usize) {
         let offset = [(slot as u64 * PARAMS_STRIDE) as u32];
         pass.set_pipeline(self.pipelines.pipeline(stage));
-        let groups = self.data.bind_groups.as_ref().expect("made with the buffers");
+        let groups = &self.data.bind_groups.as_ref().expect("made with the buffers")[stage as usize];
         let group = if stage.edits_in_place() { 1 - self.current } else { self.current };
         pass.set_bind_group(0, &groups[group], &offset);
         match stage.over() {
@@ -935,28 +945,7 @@ impl World {
     /// One of the step's buffers, read back as 32-bit words (tests).
     #[doc(hidden)]
     pub fn read_words(&self, buffer: Buffer) -> Result<Vec<u32>, Error> {
-        let [vel0, cell_count, cell_start, block_sums, sorted] = &self.data.scratch;
-        let [_, joint_start, joint_refs] = &self.data.statics;
-        let d = &self.data;
-        let b = match buffer {
-            Buffer::Params => &d.params,
-            Buffer::Props => &d.props,
-            Buffer::StateIn => &d.states[self.current],
-            Buffer::StateOut => &d.states[1 - self.current],
-            Buffer::Vel0 => vel0,
-            Buffer::CellCount => cell_count,
-            Buffer::CellStart => cell_start,
-            Buffer::BlockSums => block_sums,
-            Buffer::Sorted => sorted,
-            Buffer::Snaps => &d.snaps,
-            Buffer::Pairs => &d.pairs,
-            Buffer::Manifolds => &d.manifolds,
-            Buffer::Status => &d.status,
-            Buffer::JointStart => joint_start,
-            Buffer::JointRefs => joint_refs,
-            Buffer::PairMeta => &d.pair_meta,
-            Buffer::BodyPairs => &d.body_pairs,
-        };
+        let b = self.data.buffer(buffer, self.current);
         Ok(bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(b, b.size())?))
     }
 
@@ -1206,9 +1195,10 @@ fn finite_output(b: &BodyOutput) -> bool {
 
 fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
     let l = &gpu.limits;
-    if l.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS {
+    let needed = storage_buffers();
+    if l.max_storage_buffers_per_shader_stage < needed {
         return Err(Error::Capacity(format!(
-            "the step binds {STORAGE_BUFFERS} storage buffers per shader stage but this adapter allows {}",
+            "a pass of the step binds {needed} storage buffers but this adapter allows {} per shader stage",
             l.max_storage_buffers_per_shader_stage
         )));
     }

@@ -87,8 +87,8 @@ pub fn validate(source: &str) -> Result<naga::Module, String> {
 
 /// What entry point `entry` of the WGSL `source` does with each buffer it
 /// binds, as naga's analysis finds it: (binding, reads, writes), in binding
-/// order, for every buffer it touches. `arrayLength` alone is neither a
-/// read nor a write.
+/// order, for every buffer it touches. `arrayLength` (the binding's size)
+/// counts as a read: the buffer must be bound all the same.
 pub fn buffer_uses(source: &str, entry: &str) -> Result<Vec<(u32, bool, bool)>, String> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
     let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
@@ -102,7 +102,9 @@ pub fn buffer_uses(source: &str, entry: &str) -> Result<Vec<(u32, bool, bool)>, 
         .filter_map(|(handle, var)| {
             let binding = var.binding.as_ref()?.binding;
             let used = uses[handle];
-            let (reads, writes) = (used.contains(naga::valid::GlobalUse::READ), used.contains(naga::valid::GlobalUse::WRITE));
+            // arrayLength reads the binding's size (a query): it must be bound
+            let reads = used.intersects(naga::valid::GlobalUse::READ | naga::valid::GlobalUse::QUERY);
+            let writes = used.contains(naga::valid::GlobalUse::WRITE);
             (reads || writes).then_some((binding, reads, writes))
         })
         .collect();

@@ -215,22 +215,26 @@ impl Stage {
     /// (`tests/gpu/shaders.rs` checks both lists against it), so a branch not
     /// taken counts (the pair walks share one walk that writes in
     /// `pairs_write` and counts in `pairs_count`; the scan passes hold the
-    /// grid's case and the pairs' both). An atomic is a read and a write.
+    /// grid's case and the pairs' both). An atomic is a read and a write;
+    /// `arrayLength` is a read (the buffer must be bound).
     pub fn reads(self) -> &'static [Buffer] {
         use Buffer::*;
         match self {
             Stage::GridCount => &[Params, Props, StateIn, CellCount, Status],
-            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, CellStart, Status, PairMeta],
-            Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Status],
+            Stage::GridScanBlocks | Stage::PairsScanBlocks => &[Params, CellCount, CellStart, Pairs, Status, PairMeta],
+            Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Pairs, Status],
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
             Stage::GridSort => &[Params, StateIn, CellStart, Sorted, PairMeta],
-            Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, Status, JointStart, JointRefs, PairMeta],
-            Stage::PairsWrite => {
-                &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Status, JointStart, JointRefs, PairMeta, BodyPairs]
+            Stage::PairsCount => {
+                &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs]
             }
-            Stage::Narrowphase => &[Params, Props, StateIn, Pairs, Status, PairMeta],
-            Stage::NarrowphaseGround => &[Params, Props, StateIn, Pairs, Status, PairMeta],
+            Stage::PairsWrite => {
+                &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs]
+            }
+            Stage::Narrowphase | Stage::NarrowphaseGround => {
+                &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs]
+            }
             Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
             Stage::Integrate => &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta],
@@ -260,6 +264,12 @@ impl Stage {
             Stage::SolveContacts | Stage::RestitutionContacts => &[Snaps, Manifolds],
             Stage::Solve | Stage::SolveJoints | Stage::Restitution => &[StateOut],
         }
+    }
+
+    /// The buffers it binds (what it reads or writes), by binding: its bind
+    /// group layout holds these alone.
+    pub fn buffers(self) -> Vec<Buffer> {
+        Buffer::ALL.iter().copied().filter(|b| self.reads().contains(b) || self.writes().contains(b)).collect()
     }
 
     /// Whether the stage is part of the grid broadphase (`grid_*`).
@@ -324,58 +334,65 @@ pub enum Part {
     Restitution,
 }
 
-/// Storage buffers the step's bind group holds (bindings 1-16 of
-/// shaders/bindings.wgsl); the device must allow this many per stage.
-pub const STORAGE_BUFFERS: u32 = 16;
+/// The most storage buffers any stage binds; the device must allow this
+/// many per shader stage.
+pub fn storage_buffers() -> u32 {
+    Stage::ALL.iter().map(|s| s.buffers().iter().filter(|b| **b != Buffer::Params).count() as u32).max().unwrap_or(0)
+}
 
+/// The step's compiled pipelines, each with its own bind group layout (the
+/// buffers its entry point uses: every pass of the step binds fewer than
+/// the 16 storage buffers an adapter is asked for, though the step has
+/// more).
 pub struct StepPipelines {
-    pub layout: wgpu::BindGroupLayout,
+    layouts: Vec<wgpu::BindGroupLayout>,
     pipelines: Vec<wgpu::ComputePipeline>,
 }
 
-fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
+fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
+    let ty = match buffer {
+        // one Params slot per substep, chosen by the dynamic offset
+        Buffer::Params => wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+        },
+        // read-only where no stage writes (props, state_in, the joints)
+        _ => wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: buffer.read_only() },
             has_dynamic_offset: false,
             min_binding_size: None,
         },
-        count: None,
-    }
+    };
+    wgpu::BindGroupLayoutEntry { binding: buffer.binding(), visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
 }
 
 impl StepPipelines {
     pub fn new(gpu: &Gpu) -> StepPipelines {
         let device = &gpu.device;
-        // shaders/bindings.wgsl
-        let mut entries = vec![wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-            },
-            count: None,
-        }];
-        // read-only where no stage writes (props, state_in, the joints)
-        for buffer in &Buffer::ALL[1..] {
-            entries.push(storage(buffer.binding(), buffer.read_only()));
-        }
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("step"), entries: &entries });
+        let layouts: Vec<wgpu::BindGroupLayout> = Stage::ALL
+            .iter()
+            .map(|stage| {
+                let entries: Vec<wgpu::BindGroupLayoutEntry> = stage.buffers().into_iter().map(entry).collect();
+                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(stage.name()), entries: &entries })
+            })
+            .collect();
         let pipelines = Stage::ALL
             .iter()
             .flat_map(|stage| {
                 let constants: &[(&str, f64)] = if stage.scans_pairs() { &[("SCAN_PAIRS", 1.0)] } else { &[] };
-                gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[&layout]), constants)
+                let layout = &layouts[*stage as usize];
+                gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), constants)
             })
             .collect();
-        StepPipelines { layout, pipelines }
+        StepPipelines { layouts, pipelines }
     }
 
     pub fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {
         &self.pipelines[stage as usize]
+    }
+
+    pub fn layout(&self, stage: Stage) -> &wgpu::BindGroupLayout {
+        &self.layouts[stage as usize]
     }
 }
