@@ -21,8 +21,15 @@
 // sorted by pair index
 @group(0) @binding(10) var<storage, read_write> pairs: array<Pair>;             // pair capacity
 @group(0) @binding(11) var<storage, read_write> manifolds: array<ContactManifold>; // manifold capacity
-// what each manifold asks of its two bodies in a sweep (solve.wgsl, restitution.wgsl)
-@group(0) @binding(9) var<storage, read_write> snaps: array<EndSnap>;           // 2 x manifold capacity
+// the manifolds' points, slot by slot, in up to four parts (`point_of`)
+@group(0) @binding(17) var<storage, read_write> points: array<ManifoldPoints>;
+@group(0) @binding(18) var<storage, read_write> points_1: array<ManifoldPoints>;
+@group(0) @binding(19) var<storage, read_write> points_2: array<ManifoldPoints>;
+@group(0) @binding(20) var<storage, read_write> points_3: array<ManifoldPoints>;
+// what each manifold asks of its two bodies in a sweep (solve.wgsl,
+// restitution.wgsl), two a slot, in up to two parts (`snap_of`)
+@group(0) @binding(9) var<storage, read_write> snaps: array<EndSnap>;
+@group(0) @binding(21) var<storage, read_write> snaps_1: array<EndSnap>;
 @group(0) @binding(15) var<storage, read_write> pair_meta: array<PairMeta>;     // body_count + 1
 @group(0) @binding(16) var<storage, read_write> body_pairs: array<u32>;         // 2 x pair capacity
 // status[0]: candidate pairs wanted this step, status[1]: most in any step;
@@ -97,10 +104,73 @@ fn pool_slot(k: u32, used: u32) -> u32 {
 
 // Helpers that read the bindings (common.wgsl binds nothing).
 
+// The manifold pool is larger than one storage binding may be in a big
+// scene (lavapipe binds at most 128 MiB: 838 860 manifolds of 160 bytes, and
+// a pile of a million cubes wants more than two million), so it is split:
+// the headers (32 bytes) in `manifolds`, the points (128 bytes) in up to
+// four parts, the snaps (64 bytes a slot) in up to two. Slot k's points lie
+// in part k / P at k % P, P the first part's length (every part but the
+// last is full; a part not needed holds one entry and is never read). The
+// manifold passes run over consecutive slots, so the lanes of a vector
+// take the same part but where one part ends.
+
+// Where slot k's points lie: (part, index in it).
+fn point_slot(k: u32) -> vec2<u32> {
+    let per = arrayLength(&points);
+    let part = u32(k >= per) + u32(k >= 2u * per) + u32(k >= 3u * per);
+    return vec2<u32>(part, k - part * per);
+}
+
+// Point q of the manifold whose points lie at `at` (point_slot).
+fn point_of(at: vec2<u32>, q: u32) -> ContactPoint {
+    switch (at.x) {
+        case 0u: { return points[at.y].at[q]; }
+        case 1u: { return points_1[at.y].at[q]; }
+        case 2u: { return points_2[at.y].at[q]; }
+        default: { return points_3[at.y].at[q]; }
+    }
+}
+
+// Sets point q's friction budget (`pushed`) of the manifold at `at`.
+fn set_pushed(at: vec2<u32>, q: u32, pushed: f32) {
+    switch (at.x) {
+        case 0u: { points[at.y].at[q].pushed = pushed; }
+        case 1u: { points_1[at.y].at[q].pushed = pushed; }
+        case 2u: { points_2[at.y].at[q].pushed = pushed; }
+        default: { points_3[at.y].at[q].pushed = pushed; }
+    }
+}
+
+// Stores slot k's points.
+fn store_points(k: u32, p: ManifoldPoints) {
+    let at = point_slot(k);
+    switch (at.x) {
+        case 0u: { points[at.y] = p; }
+        case 1u: { points_1[at.y] = p; }
+        case 2u: { points_2[at.y] = p; }
+        default: { points_3[at.y] = p; }
+    }
+}
+
 // The snap manifold `r >> 1` asks of the body that holds reference r: at
-// r itself (a's at 2 x the slot, b's next), one load with no branch.
+// r itself (a's at 2 x the slot, b's next), in the first part of the snaps
+// or, past its end, the second.
 fn snap_of(r: u32) -> EndSnap {
-    return snaps[r];
+    let per = arrayLength(&snaps);
+    if (r < per) {
+        return snaps[r];
+    }
+    return snaps_1[r - per];
+}
+
+// Stores the snap at reference r (see snap_of).
+fn set_snap(r: u32, s: EndSnap) {
+    let per = arrayLength(&snaps);
+    if (r < per) {
+        snaps[r] = s;
+    } else {
+        snaps_1[r - per] = s;
+    }
 }
 
 // Sleeping (settings.sleeping; the paper has none). A body that has been

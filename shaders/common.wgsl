@@ -119,7 +119,9 @@ struct ContactPoint {
 }
 
 // A pair's contact manifold, found once per step: up to MAX_POINTS points
-// sharing one world normal, pointing from a to b (GROUND or a body). 160 bytes.
+// sharing one world normal, pointing from a to b (GROUND or a body). Its
+// header (32 bytes) here; its points at the same slot of the pool's point
+// parts (ManifoldPoints, see `point_of` in bindings.wgsl).
 struct ContactManifold {
     normal: vec3<f32>,
     count: u32,
@@ -127,7 +129,11 @@ struct ContactManifold {
     b: u32,
     clip_face: u32, // NONE, or the reference face narrowphase_clip still has to clip
     pair: u32,      // the candidate pair (index in `pairs`) it was found for
-    points: array<ContactPoint, 4>,
+}
+
+// A manifold's points (the first `count`; 128 bytes).
+struct ManifoldPoints {
+    at: array<ContactPoint, 4>,
 }
 
 // What one manifold asks of one of its bodies in a sweep, summed over its
@@ -140,7 +146,8 @@ struct ContactManifold {
 // above SUPPORT_SHIFT (15 bits) the share of the move that pushes out
 // shallower old overlap, in 1/SUPPORT_ONE (solve only; see solve.wgsl). A
 // manifold's two, a's then b's, sit at 2 x its slot: a body reads its at
-// its contact reference (contact_ref). 32 bytes.
+// its contact reference (contact_ref; see `snap_of` in bindings.wgsl).
+// 32 bytes.
 struct EndSnap {
     dx: vec3<f32>,
     count: u32,

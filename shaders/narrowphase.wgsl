@@ -98,13 +98,7 @@ fn wake_check(sleeper: u32, other: u32, gap: f32) {
 // `slot`, its points in the bodies' own frames, and wakes a sleeper that an
 // awake partner presses or hits.
 fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
-    var stored: ContactManifold;
-    stored.normal = m.normal;
-    stored.count = m.count;
-    stored.a = a;
-    stored.b = b;
-    stored.clip_face = NONE;
-    stored.pair = pair;
+    var kept: ManifoldPoints;
     var deepest = 3.4e38;
     for (var k = 0u; k < MAX_POINTS; k = k + 1u) {
         if (k < m.count) {
@@ -112,11 +106,12 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
             if (b != GROUND) {
                 local_b = world_to_local(b, m.on_b[k]);
             }
-            stored.points[k] = ContactPoint(world_to_local(a, m.on_a[k]), 0.0, local_b, 0.0);
+            kept.at[k] = ContactPoint(world_to_local(a, m.on_a[k]), 0.0, local_b, 0.0);
             deepest = min(deepest, dot(m.on_b[k] - m.on_a[k], m.normal));
         }
     }
-    manifolds[slot] = stored;
+    manifolds[slot] = ContactManifold(m.normal, m.count, a, b, NONE, pair);
+    store_points(slot, kept);
     // only an awake partner wakes a sleeper, so of the two checks (a by b,
     // b by a) only the one for a sleeping a can act if a sleeps, only the
     // other if not: one check, one copy of it in the kernel

@@ -64,9 +64,10 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let eb = contact_end(b);
     let n = manifolds[k].normal; // from a to b
     let count = manifolds[k].count;
+    let at = point_slot(k);
     if (!ea.moves && !eb.moves) {
         for (var q = 0u; q < count; q = q + 1u) {
-            manifolds[k].points[q].pushed = 0.0;
+            set_pushed(at, q, 0.0);
         }
         return;
     }
@@ -97,8 +98,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     var bounce_inv_w = 0.0;
     var acting = 0u;
     for (var q = 0u; q < count; q = q + 1u) {
-        let pt = manifolds[k].points[q];
-        manifolds[k].points[q].pushed = 0.0;
+        let pt = point_of(at, q);
+        set_pushed(at, q, 0.0);
         let ra = ea.rot_m * end_point(ea, pt.local_a, n);
         let rb = eb.rot_m * end_point(eb, pt.local_b, -n);
         // touching?
@@ -160,8 +161,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     moment_a = moment_a + bounce_moment_a * bounce_scale;
     moment_b = moment_b + bounce_moment_b * bounce_scale;
     let flags = select(0u, SNAP_BOUNCE, bounce_inv_w > 0.0);
-    snaps[contact_ref(k, false)] = end_snap(ea, -j, -moment_a, acting, flags);
-    snaps[contact_ref(k, true)] = end_snap(eb, j, moment_b, acting, flags);
+    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a, acting, flags));
+    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b, acting, flags));
 }
 
 @compute @workgroup_size(WORKGROUP)

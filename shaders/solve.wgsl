@@ -126,6 +126,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let a = manifolds[k].a;
     let b = manifolds[k].b;
     let count = manifolds[k].count;
+    let at = point_slot(k);
     var ea = contact_end(a);
     var eb = contact_end(b);
     if (!ea.moves && !eb.moves) {
@@ -165,7 +166,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     var shallow_depth = 0.0;
     var all_depth = 0.0;
     for (var q = 0u; q < count; q = q + 1u) {
-        let pt = manifolds[k].points[q];
+        let pt = point_of(at, q);
         let local_a = end_point(ea, pt.local_a, n);
         let local_b = end_point(eb, pt.local_b, -n);
         let ra = ea.rot_m * local_a;
@@ -224,7 +225,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
                 snapped = true;
             }
         }
-        manifolds[k].points[q].pushed = pt.pushed + push;
+        set_pushed(at, q, pt.pushed + push);
         if (pt.pushed + push > 0.0) {
             pressed = 1u;
         }
@@ -249,8 +250,8 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let settle = u32(round(clamp(old_depth / max(all_depth, 1e-30), 0.0, 1.0) * SETTLE_ONE));
     let support = u32(round(clamp(shallow_depth / max(all_depth, 1e-30), 0.0, 1.0) * SUPPORT_ONE));
     let flags = select(0u, SNAP_PRESSED, pressed != 0u) | (settle << SETTLE_SHIFT) | (support << SUPPORT_SHIFT);
-    snaps[contact_ref(k, false)] = end_snap(ea, -j, -moment_a * turns, touched, flags);
-    snaps[contact_ref(k, true)] = end_snap(eb, j, moment_b * turns, touched, flags);
+    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns, touched, flags));
+    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns, touched, flags));
 }
 
 @compute @workgroup_size(WORKGROUP)

@@ -44,10 +44,13 @@ struct WorldData {
     /// The pair pipeline (shaders/pairs.wgsl): candidate pairs, the
     /// manifold pool, each body's pair bookkeeping and its pair list.
     pairs: wgpu::Buffer,
+    /// The manifolds' headers, and their points in up to four parts (see
+    /// `pool_parts`).
     manifolds: wgpu::Buffer,
-    /// What each manifold asks of its two bodies in a sweep (one per
-    /// manifold slot; solve.wgsl, restitution.wgsl).
-    snaps: wgpu::Buffer,
+    points: [wgpu::Buffer; 4],
+    /// What each manifold asks of its two bodies in a sweep (two per
+    /// manifold slot; solve.wgsl, restitution.wgsl), in up to two parts.
+    snaps: [wgpu::Buffer; 2],
     pair_meta: wgpu::Buffer,
     body_pairs: wgpu::Buffer,
     /// The indirect dispatches: the narrowphase's at 0, copied from
@@ -90,7 +93,12 @@ impl WorldData {
             Buffer::CellStart => cell_start,
             Buffer::BlockSums => block_sums,
             Buffer::Sorted => sorted,
-            Buffer::Snaps => &self.snaps,
+            Buffer::Snaps => &self.snaps[0],
+            Buffer::Snaps1 => &self.snaps[1],
+            Buffer::Points => &self.points[0],
+            Buffer::Points1 => &self.points[1],
+            Buffer::Points2 => &self.points[2],
+            Buffer::Points3 => &self.points[3],
             Buffer::Pairs => &self.pairs,
             Buffer::Manifolds => &self.manifolds,
             Buffer::Status => &self.status,
@@ -281,19 +289,45 @@ pub const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 pub const MANIFOLDS_PER_BODY: u64 = 3;
 
 /// The pair list's and the manifold pool's sizes for `n` bodies on `gpu`:
-/// per body as above, within one storage binding and one dispatch (the
-/// passes over them are dispatched indirectly, and wgpu's check of an
-/// indirect dispatch's size is off: see `Gpu::new`).
+/// per body as above, within one dispatch (the passes over them are
+/// dispatched indirectly, and wgpu's check of an indirect dispatch's size
+/// is off: see `Gpu::new`), the pair list within one storage binding, the
+/// pool within its parts' (`pool_parts`).
 pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
     let binding = binding_limit(gpu);
     let by_dispatch = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
     let pairs = n.saturating_mul(PAIRS_PER_BODY).max(MIN_POOL).min(binding / std::mem::size_of::<Pair>() as u64).min(by_dispatch);
+    let (points_per_part, snaps_per_part) = pool_part_lengths(gpu);
     let manifolds = n
         .saturating_mul(MANIFOLDS_PER_BODY)
         .max(MIN_POOL)
         .min(binding / std::mem::size_of::<ContactManifold>() as u64)
+        .min(4 * points_per_part)
+        .min(2 * snaps_per_part / 2)
         .min(by_dispatch);
     (pairs, manifolds)
+}
+
+/// Most entries a part of the pool's points and of its snaps holds: one
+/// storage binding's worth (bindings.wgsl's `point_of`, `snap_of`).
+fn pool_part_lengths(gpu: &Gpu) -> (u64, u64) {
+    let binding = binding_limit(gpu);
+    (binding / std::mem::size_of::<ManifoldPoints>() as u64, binding / std::mem::size_of::<EndSnap>() as u64)
+}
+
+/// The sizes (bytes) of a pool of `manifolds` slots: its headers, its
+/// points' four parts and its snaps' two. Every part but the last used is
+/// full; a part not used holds one entry, never read.
+fn pool_parts(gpu: &Gpu, manifolds: u64) -> (u64, [u64; 4], [u64; 2]) {
+    let (points_per_part, snaps_per_part) = pool_part_lengths(gpu);
+    let part = |k: u64, total: u64, per: u64| total.saturating_sub(k * per).min(per).max(1);
+    let points = std::mem::size_of::<ManifoldPoints>() as u64;
+    let snap = std::mem::size_of::<EndSnap>() as u64;
+    (
+        manifolds * std::mem::size_of::<ContactManifold>() as u64,
+        [0, 1, 2, 3].map(|k| part(k, manifolds, points_per_part) * points),
+        [0, 1].map(|k| part(k, 2 * manifolds, snaps_per_part) * snap),
+    )
 }
 
 /// Bytes of GPU memory per body as a world is made: its own share
@@ -325,7 +359,7 @@ pub fn pair_bytes() -> u64 {
 
 /// Bytes a manifold takes: its slot in the pool and its two snaps.
 pub fn manifold_bytes() -> u64 {
-    (std::mem::size_of::<ContactManifold>() + 2 * std::mem::size_of::<EndSnap>()) as u64
+    (std::mem::size_of::<ContactManifold>() + std::mem::size_of::<ManifoldPoints>() + 2 * std::mem::size_of::<EndSnap>()) as u64
 }
 
 /// The host's side of where a batch of steps started (`World::batch_start`).
@@ -394,16 +428,7 @@ impl World {
         let (props, large, grid) = scene_props(scene);
         let states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &settings)).collect();
 
-        let storage = |label: &str, size: u64| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                // at least one element of the largest struct a binding holds (an empty
-                // list still binds a buffer as large as the shader's element)
-                size: size.max(64),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
+        let storage = |label: &str, size: u64| storage_buffer(device, label, size);
         let with_data = |label: &str, bytes: &[u8]| {
             let buf = storage(label, bytes.len() as u64);
             if !bytes.is_empty() {
@@ -424,8 +449,10 @@ impl World {
         let large_buf = with_data("grid/large", bytemuck::cast_slice(&large));
         let (pair_capacity, manifold_capacity) = pair_capacities(&gpu, count as u64);
         let pairs = storage("pairs", pair_capacity * std::mem::size_of::<Pair>() as u64);
-        let manifolds = storage("manifolds", manifold_capacity * std::mem::size_of::<ContactManifold>() as u64);
-        let snaps = storage("manifolds/snaps", manifold_capacity * 2 * std::mem::size_of::<EndSnap>() as u64);
+        let (heads, point_parts, snap_parts) = pool_parts(&gpu, manifold_capacity);
+        let manifolds = storage("manifolds", heads);
+        let points = point_parts.map(|size| storage("manifolds/points", size));
+        let snaps = snap_parts.map(|size| storage("manifolds/snaps", size));
         let meta_bytes = (count as u64 + 1) * std::mem::size_of::<PairMeta>() as u64;
         let pair_meta = storage("pairs/meta", meta_bytes);
         let state_bytes = (count * std::mem::size_of::<BodyState>()) as u64;
@@ -453,6 +480,7 @@ impl World {
             status,
             pairs,
             manifolds,
+            points,
             snaps,
             pair_meta,
             body_pairs,
@@ -696,14 +724,7 @@ impl World {
     fn make_pools(&mut self, pairs: u64, manifolds: u64, keep: bool) -> Result<(), Error> {
         let (pair_capacity, manifold_capacity) = self.capacities();
         let device = &self.gpu.device;
-        let storage = |label: &str, size: u64| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
+        let storage = |label: &str, size: u64| storage_buffer(device, label, size);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("resize pools") });
         let mut remake = |old: &mut wgpu::Buffer, label: &str, size: u64| {
             let new = storage(label, size);
@@ -717,8 +738,14 @@ impl World {
             remake(&mut self.data.body_pairs, "pairs/body_lists", 2 * pairs * 4);
         }
         if manifolds != manifold_capacity as u64 {
-            remake(&mut self.data.manifolds, "manifolds", manifolds * std::mem::size_of::<ContactManifold>() as u64);
-            remake(&mut self.data.snaps, "manifolds/snaps", manifolds * 2 * std::mem::size_of::<EndSnap>() as u64);
+            let (heads, point_parts, snap_parts) = pool_parts(&self.gpu, manifolds);
+            remake(&mut self.data.manifolds, "manifolds", heads);
+            for (buffer, size) in self.data.points.iter_mut().zip(point_parts) {
+                remake(buffer, "manifolds/points", size);
+            }
+            for (buffer, size) in self.data.snaps.iter_mut().zip(snap_parts) {
+                remake(buffer, "manifolds/snaps", size);
+            }
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines));
@@ -1040,9 +1067,10 @@ impl World {
     /// grown, and the input kernels' buffers once an input was given.
     pub fn gpu_bytes(&self) -> u64 {
         let d = &self.data;
-        let buffers = [&d.params, &d.status, &d.pairs, &d.manifolds, &d.snaps, &d.pair_meta, &d.body_pairs, &d.dispatch, &d.props];
+        let buffers = [&d.params, &d.status, &d.pairs, &d.manifolds, &d.pair_meta, &d.body_pairs, &d.dispatch, &d.props];
         buffers.iter().map(|b| b.size()).sum::<u64>()
             + d.states.iter().chain(&d.statics).chain(&d.scratch).chain(&d.batch_start).map(|b| b.size()).sum::<u64>()
+            + d.points.iter().chain(&d.snaps).map(|b| b.size()).sum::<u64>()
             + self.input.as_ref().map_or(0, |i| i.gpu_bytes())
     }
 
@@ -1108,15 +1136,20 @@ impl World {
         let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&read(&self.data.pair_meta)?);
         let lists: Vec<u32> = bytemuck::pod_collect_to_vec(&read(&self.data.body_pairs)?);
         let manifolds: Vec<ContactManifold> = bytemuck::pod_collect_to_vec(&read(&self.data.manifolds)?);
+        // the parts in order: every part but the last used is full
+        let mut points: Vec<ManifoldPoints> = Vec::new();
+        for part in &self.data.points {
+            points.extend(bytemuck::pod_collect_to_vec::<u8, ManifoldPoints>(&read(part)?));
+        }
         let mut out = vec![Vec::new(); n];
         for (i, list) in out.iter_mut().enumerate() {
             // contact references (shaders/narrowphase.wgsl's contact_lists)
             let first = meta[i].list_start as usize;
             let entries = lists.get(first..first + meta[i].contacts as usize).unwrap_or(&[]);
             for &r in entries {
-                let Some(m) = manifolds.get(r as usize / 2) else { continue };
+                let (Some(m), Some(p)) = (manifolds.get(r as usize / 2), points.get(r as usize / 2)) else { continue };
                 let me_a = r % 2 == 0;
-                for pt in &m.points[..m.count as usize] {
+                for pt in &p.at[..m.count as usize] {
                     let (local_self, partner, local_partner, sign) =
                         if me_a { (pt.local_a, m.b, pt.local_b, -1.0) } else { (pt.local_b, m.a, pt.local_a, 1.0) };
                     list.push(BodyContact { local_self, partner, local_partner, normal: m.normal.map(|v| v * sign) });
@@ -1212,6 +1245,18 @@ fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
         )));
     }
     Ok(())
+}
+
+/// A storage buffer of the step (copied to and from), of at least one
+/// element of the largest struct a binding holds: an empty list still binds
+/// a buffer as large as the shader's element.
+fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(64),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
 
 fn binding_limit(gpu: &Gpu) -> u64 {

@@ -144,8 +144,10 @@ pub struct ContactPoint {
     pub _pad0: f32,
 }
 
-/// A pair's manifold (160 bytes): up to `MAX_POINTS` points sharing one
-/// world normal, pointing from a to b (a body, or `GROUND`).
+/// A pair's manifold's header (32 bytes): up to `MAX_POINTS` points sharing
+/// one world normal, pointing from a to b (a body, or `GROUND`); its points
+/// are a `ManifoldPoints` at the same slot of the pool's point parts
+/// (`point_of` in bindings.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ContactManifold {
@@ -157,7 +159,13 @@ pub struct ContactManifold {
     pub clip_face: u32,
     /// The candidate pair (index into the pair list) it was found for.
     pub pair: u32,
-    pub points: [ContactPoint; 4],
+}
+
+/// A manifold's points (the first `count`; 128 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ManifoldPoints {
+    pub at: [ContactPoint; 4],
 }
 
 /// What a manifold asks of one of its bodies in a sweep (32 bytes); see

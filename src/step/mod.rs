@@ -94,10 +94,17 @@ pub enum Buffer {
     JointRefs = 14,
     PairMeta = 15,
     BodyPairs = 16,
+    /// The manifolds' points, in up to four parts (`point_of` in
+    /// bindings.wgsl), and the snaps' second part (`snap_of`).
+    Points = 17,
+    Points1 = 18,
+    Points2 = 19,
+    Points3 = 20,
+    Snaps1 = 21,
 }
 
 impl Buffer {
-    pub const ALL: [Buffer; 17] = [
+    pub const ALL: [Buffer; 22] = [
         Buffer::Params,
         Buffer::Props,
         Buffer::StateIn,
@@ -115,6 +122,11 @@ impl Buffer {
         Buffer::JointRefs,
         Buffer::PairMeta,
         Buffer::BodyPairs,
+        Buffer::Points,
+        Buffer::Points1,
+        Buffer::Points2,
+        Buffer::Points3,
+        Buffer::Snaps1,
     ];
 
     pub fn binding(self) -> u32 {
@@ -233,16 +245,20 @@ impl Stage {
                 &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs]
             }
             Stage::Narrowphase | Stage::NarrowphaseGround => {
-                &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs]
+                &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs, Points]
             }
             Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
-            Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
+            Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta, Points],
             Stage::Integrate => &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta],
-            Stage::SolveContacts => &[Params, Props, StateIn, Manifolds, Status, PairMeta],
-            Stage::Solve => &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart],
+            Stage::SolveContacts => {
+                &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3]
+            }
+            Stage::Solve => &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1],
             Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
-            Stage::RestitutionContacts => &[Params, Props, StateIn, Vel0, Manifolds, Status, PairMeta],
-            Stage::Restitution => &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs],
+            Stage::RestitutionContacts => {
+                &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3]
+            }
+            Stage::Restitution => &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, Snaps1],
         }
     }
 
@@ -257,11 +273,13 @@ impl Stage {
             Stage::GridScatter => &[CellCount, Sorted],
             Stage::GridSort => &[Sorted],
             Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
-            Stage::Narrowphase | Stage::NarrowphaseGround => &[Manifolds, Status, PairMeta, BodyPairs],
+            Stage::Narrowphase | Stage::NarrowphaseGround => {
+                &[Manifolds, Status, PairMeta, BodyPairs, Points, Points1, Points2, Points3]
+            }
             Stage::ContactLists => &[Sorted, Status, PairMeta, BodyPairs],
-            Stage::NarrowphaseClip => &[Manifolds, PairMeta],
+            Stage::NarrowphaseClip => &[Manifolds, PairMeta, Points, Points1, Points2, Points3],
             Stage::Integrate => &[StateOut, Vel0, Status, PairMeta],
-            Stage::SolveContacts | Stage::RestitutionContacts => &[Snaps, Manifolds],
+            Stage::SolveContacts | Stage::RestitutionContacts => &[Snaps, Points, Points1, Points2, Points3, Snaps1],
             Stage::Solve | Stage::SolveJoints | Stage::Restitution => &[StateOut],
         }
     }

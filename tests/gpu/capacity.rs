@@ -56,7 +56,8 @@ fn the_pair_pools_grow_for_a_crowded_scene() {
     assert_eq!(first.pairs, lattice_pairs, "the first step's candidate pairs");
     assert!(second.pair_capacity >= lattice_pairs, "the list did not grow: {second:?}");
     // the memory the world reports follows the pools it grew
-    let grown = |r: &verlet::world::ContactReport| r.pair_capacity as u64 * (8 + 2 * 4) + r.manifold_capacity as u64 * (160 + 64);
+    let grown =
+        |r: &verlet::world::ContactReport| r.pair_capacity as u64 * (8 + 2 * 4) + r.manifold_capacity as u64 * (32 + 128 + 64);
     assert_eq!(w.gpu_bytes() - bytes_before, grown(&second) - grown(&before), "gpu_bytes does not follow the pools");
     // the balls push apart (at most 3 m/s) and their reach grows with their
     // speed, so later steps may want more pairs; each growth keeps up
@@ -218,4 +219,33 @@ fn the_pools_shrink_while_nothing_touches_and_grow_again_without_a_loss() {
     eprintln!("restored crowded, one step: {again:?}");
     assert!(again.manifold_capacity >= 1225 && again.manifolds_max >= 1225 && !again.overflowed(), "{again:?}");
     assert!(bits(&w) == after_one, "the step taken on shrunk pools differs from the crowded world's");
+}
+
+/// A manifold pool larger than one storage binding is split into parts
+/// (bindings.wgsl's `point_of` and `snap_of`: lavapipe binds at most 128
+/// MiB, 838 860 whole manifolds, and a pile of a million cubes wants more
+/// than two million). Made to bind at most 64 KiB, a GPU splits the pool of
+/// a 700-cube pile (2048 slots) over all four parts of the points (512
+/// slots each) and both of the snaps (1024 slots each); the pile steps to
+/// the same bits as on the GPU as it is, its pool in one part each.
+#[test]
+fn a_pool_split_over_bindings_steps_to_the_same_bits() {
+    let Some(gpu) = crate::common::gpu() else { return };
+    let mut small = verlet::gpu::Gpu::new().unwrap();
+    small.limits.max_storage_buffer_binding_size = 64 << 10;
+    let scene = scenes::pile(700, 3);
+    let mut split = World::with_gpu(std::sync::Arc::new(small), &scene).unwrap();
+    let mut whole = World::with_gpu(gpu, &scene).unwrap();
+    let made = split.contact_report().unwrap();
+    assert_eq!(made.manifold_capacity, 2048, "{made:?}");
+    for _ in 0..4 {
+        split.step(30).unwrap();
+        whole.step(30).unwrap();
+        assert!(bits(&split) == bits(&whole), "the split pool's poses differ after {} steps", split.step_count());
+    }
+    let report = split.contact_report().unwrap();
+    eprintln!("split: made {made:?}, after 120 steps {report:?}");
+    assert!(report.manifold_capacity > 3 * 512 && report.manifolds_max > 1024 && !report.overflowed(), "{report:?}");
+    // the contacts read back across the parts are the same too
+    assert_eq!(split.read_contacts().unwrap(), whole.read_contacts().unwrap());
 }
