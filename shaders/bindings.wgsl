@@ -112,10 +112,18 @@ fn pool_slot(k: u32, used: u32) -> u32 {
 // in part k / P at k % P, P the first part's length (every part but the
 // last is full; a part not needed holds one entry and is never read). The
 // manifold passes run over consecutive slots, so the lanes of a vector
-// take the same part but where one part ends.
+// take the same part but where one part ends. A pool within one part (every
+// scene but the largest) is read and written with POOL_SPLIT off, which
+// folds every access below to one load or store with no branch (the
+// branches cost the contact passes a sixth of their time); World's
+// make_pools compiles the passes again with it on once a pool needs parts.
+override POOL_SPLIT: bool = false;
 
 // Where slot k's points lie: (part, index in it).
 fn point_slot(k: u32) -> vec2<u32> {
+    if (!POOL_SPLIT) {
+        return vec2<u32>(0u, k);
+    }
     let per = arrayLength(&points);
     let part = u32(k >= per) + u32(k >= 2u * per) + u32(k >= 3u * per);
     return vec2<u32>(part, k - part * per);
@@ -157,7 +165,7 @@ fn store_points(k: u32, p: ManifoldPoints) {
 // or, past its end, the second.
 fn snap_of(r: u32) -> EndSnap {
     let per = arrayLength(&snaps);
-    if (r < per) {
+    if (!POOL_SPLIT || r < per) {
         return snaps[r];
     }
     return snaps_1[r - per];
@@ -166,7 +174,7 @@ fn snap_of(r: u32) -> EndSnap {
 // Stores the snap at reference r (see snap_of).
 fn set_snap(r: u32, s: EndSnap) {
     let per = arrayLength(&snaps);
-    if (r < per) {
+    if (!POOL_SPLIT || r < per) {
         snaps[r] = s;
     } else {
         snaps_1[r - per] = s;

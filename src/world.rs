@@ -315,6 +315,12 @@ fn pool_part_lengths(gpu: &Gpu) -> (u64, u64) {
     (binding / std::mem::size_of::<ManifoldPoints>() as u64, binding / std::mem::size_of::<EndSnap>() as u64)
 }
 
+/// Whether a pool of `manifolds` slots takes more than one part (the first
+/// part of the snaps holds twice the slots of the first part of the points).
+fn pool_in_parts(gpu: &Gpu, manifolds: u64) -> bool {
+    manifolds > pool_part_lengths(gpu).0
+}
+
 /// The sizes (bytes) of a pool of `manifolds` slots: its headers, its
 /// points' four parts and its snaps' two. Every part but the last used is
 /// full; a part not used holds one entry, never read.
@@ -473,7 +479,7 @@ impl World {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let pipelines = StepPipelines::new(&gpu);
+        let pipelines = StepPipelines::new(&gpu, pool_in_parts(&gpu, manifold_capacity));
         let mut data = WorldData {
             states: state_bufs,
             params,
@@ -748,6 +754,10 @@ impl World {
             }
         }
         self.gpu.queue.submit([encoder.finish()]);
+        if pool_in_parts(&self.gpu, manifolds) && !self.pipelines.pool_split {
+            // once, for the largest scenes: the passes read and write the parts
+            self.pipelines = StepPipelines::new(&self.gpu, true);
+        }
         self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines));
         self.gpu.check()?;
         Ok(())

@@ -365,6 +365,8 @@ pub fn storage_buffers() -> u32 {
 pub struct StepPipelines {
     layouts: Vec<wgpu::BindGroupLayout>,
     pipelines: Vec<wgpu::ComputePipeline>,
+    /// Compiled for a manifold pool in parts (POOL_SPLIT in bindings.wgsl).
+    pub pool_split: bool,
 }
 
 fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
@@ -386,7 +388,9 @@ fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl StepPipelines {
-    pub fn new(gpu: &Gpu) -> StepPipelines {
+    /// Compiles the step's passes, for a manifold pool in parts where
+    /// `pool_split` (see `World::make_pools`).
+    pub fn new(gpu: &Gpu, pool_split: bool) -> StepPipelines {
         let device = &gpu.device;
         let layouts: Vec<wgpu::BindGroupLayout> = Stage::ALL
             .iter()
@@ -398,12 +402,15 @@ impl StepPipelines {
         let pipelines = Stage::ALL
             .iter()
             .flat_map(|stage| {
-                let constants: &[(&str, f64)] = if stage.scans_pairs() { &[("SCAN_PAIRS", 1.0)] } else { &[] };
+                let mut constants = vec![("POOL_SPLIT", f64::from(u8::from(pool_split)))];
+                if stage.scans_pairs() {
+                    constants.push(("SCAN_PAIRS", 1.0));
+                }
                 let layout = &layouts[*stage as usize];
-                gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), constants)
+                gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), &constants)
             })
             .collect();
-        StepPipelines { layouts, pipelines }
+        StepPipelines { layouts, pipelines, pool_split }
     }
 
     pub fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {

@@ -248,4 +248,15 @@ fn a_pool_split_over_bindings_steps_to_the_same_bits() {
     assert!(report.manifold_capacity > 3 * 512 && report.manifolds_max > 1024 && !report.overflowed(), "{report:?}");
     // the contacts read back across the parts are the same too
     assert_eq!(split.read_contacts().unwrap(), whole.read_contacts().unwrap());
+    // a pool that grows into parts (the passes compiled again for them):
+    // fifty boxes at one point want 1225 manifolds, room for 150 at first
+    let scene = fifty_at_one_point();
+    let mut split = World::with_gpu(split.gpu().clone(), &scene).unwrap();
+    let mut whole = crate::common::world(&scene).unwrap();
+    assert!(split.contact_report().unwrap().manifold_capacity <= 512);
+    split.step(3).unwrap();
+    whole.step(3).unwrap();
+    let report = split.contact_report().unwrap();
+    assert!(report.manifold_capacity > 2 * 512 && report.manifolds_max >= 1225 && !report.overflowed(), "{report:?}");
+    assert!(bits(&split) == bits(&whole), "the pool grown into parts steps differently");
 }
