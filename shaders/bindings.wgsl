@@ -88,6 +88,27 @@ fn large_body(k: u32) -> u32 {
     return sorted[params.body_count - params.large_count + k];
 }
 
+// Workgroups in a row of an indirect dispatch over the pairs or the
+// manifolds: the device's limit for one dimension (StepPipelines sets it).
+// A pile of a million cubes has more than 65535 x WORKGROUP pairs, so those
+// dispatches come in rows (y) of at most this many workgroups (x).
+override DISPATCH_ROW: u32 = 65535u;
+
+// Writes the indirect dispatch of `count` invocations at status[at ..
+// at + 3]: as few rows as hold them, of equal length.
+fn write_dispatch(at: u32, count: u32) {
+    let groups = (count + WORKGROUP - 1u) / WORKGROUP;
+    let rows = max((groups + DISPATCH_ROW - 1u) / DISPATCH_ROW, 1u);
+    atomicStore(&status[at], (groups + rows - 1u) / rows);
+    atomicStore(&status[at + 1u], rows);
+    atomicStore(&status[at + 2u], 1u);
+}
+
+// The invocation's place in a dispatch that write_dispatch sized.
+fn dispatch_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return gid.x + gid.y * groups.x * WORKGROUP;
+}
+
 // The manifolds this step's narrowphase stored (status[4], within the pool).
 fn manifolds_used() -> u32 {
     return min(atomicLoad(&status[4]), arrayLength(&manifolds));

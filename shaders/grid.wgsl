@@ -198,9 +198,7 @@ fn finish_scan(sum: vec2<u32>) {
         let listed = min(sum.x, arrayLength(&pairs));
         atomicStore(&status[0], sum.x);
         atomicMax(&status[1], sum.x);
-        atomicStore(&status[8], (listed + WORKGROUP - 1u) / WORKGROUP);
-        atomicStore(&status[9], 1u);
-        atomicStore(&status[10], 1u);
+        write_dispatch(8u, listed);
     }
 }
 

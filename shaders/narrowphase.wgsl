@@ -157,8 +157,8 @@ fn list_contact(i: u32, r: u32) {
 }
 
 @compute @workgroup_size(WORKGROUP)
-fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let p = gid.x;
+fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let p = dispatch_index(gid, groups);
     if (p >= min(atomicLoad(&status[0]), arrayLength(&pairs))) {
         return;
     }
@@ -238,11 +238,12 @@ fn narrowphase_ground(@builtin(global_invocation_id) gid: vec3<u32>) {
 // past that run return at once. (A face contact whose clipping keeps no
 // point stays, empty: it pushes nothing.)
 @compute @workgroup_size(WORKGROUP)
-fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= min(atomicLoad(&status[6]), manifolds_used())) {
+fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let nth = dispatch_index(gid, groups);
+    if (nth >= min(atomicLoad(&status[6]), manifolds_used())) {
         return;
     }
-    let k = arrayLength(&manifolds) - 1u - gid.x;
+    let k = arrayLength(&manifolds) - 1u - nth;
     let face = manifolds[k].clip_face;
     let ia = manifolds[k].a;
     let ib = manifolds[k].b;
@@ -271,10 +272,7 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         // the most manifolds any step wanted (status[4] counts the slots
         // the pool could not give too)
         atomicMax(&status[5], atomicLoad(&status[4]));
-        let used = manifolds_used();
-        atomicStore(&status[12], (used + WORKGROUP - 1u) / WORKGROUP);
-        atomicStore(&status[13], 1u);
-        atomicStore(&status[14], 1u);
+        write_dispatch(12u, manifolds_used());
         // the pair walks are done: grid_count sets it again next step
         atomicStore(&status[11], 0u);
     }

@@ -52,12 +52,13 @@ fn end_velocity_before(i: u32, e: ContactEnd) -> Velocity {
 }
 
 @compute @workgroup_size(WORKGROUP)
-fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let used = manifolds_used();
-    if (gid.x >= used) {
+    let nth = dispatch_index(gid, groups);
+    if (nth >= used) {
         return;
     }
-    let k = pool_slot(gid.x, used);
+    let k = pool_slot(nth, used);
     let a = manifolds[k].a;
     let b = manifolds[k].b;
     let ea = contact_end(a);

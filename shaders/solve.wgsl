@@ -115,12 +115,13 @@ fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
 }
 
 @compute @workgroup_size(WORKGROUP)
-fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let used = manifolds_used();
-    if (gid.x >= used) {
+    let nth = dispatch_index(gid, groups);
+    if (nth >= used) {
         return;
     }
-    let k = pool_slot(gid.x, used);
+    let k = pool_slot(nth, used);
     // the header, read once (the pool is written here, so a second read
     // is a second load: a loop over the lanes on lavapipe)
     let a = manifolds[k].a;

@@ -798,6 +798,8 @@ fn info() -> Result<(), Error> {
         pair_bytes(),
         manifold_bytes()
     );
+    let (most_pairs, most_manifolds) = verlet::world::pair_capacities(&gpu, u64::MAX);
+    println!("contact pools at most:      {most_pairs} pairs, {most_manifolds} manifolds");
     println!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu));
     if i.name.contains("llvmpipe") {
         // lavapipe hands every dispatch to its worker threads, and that

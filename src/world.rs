@@ -289,22 +289,22 @@ pub const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 pub const MANIFOLDS_PER_BODY: u64 = 3;
 
 /// The pair list's and the manifold pool's sizes for `n` bodies on `gpu`:
-/// per body as above, within one dispatch (the passes over them are
-/// dispatched indirectly, and wgpu's check of an indirect dispatch's size
-/// is off: see `Gpu::new`), the pair list within one storage binding, the
-/// pool within its parts' (`pool_parts`).
+/// per body as above; the pair list (and the bodies' lists, two words a
+/// pair) within one storage binding, the pool within its parts'
+/// (`pool_parts`). The passes over them are dispatched indirectly, in rows
+/// (`write_dispatch` in bindings.wgsl), and wgpu's check of an indirect
+/// dispatch's size is off (see `Gpu::new`).
 pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
     let binding = binding_limit(gpu);
-    let by_dispatch = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
-    let pairs = n.saturating_mul(PAIRS_PER_BODY).max(MIN_POOL).min(binding / std::mem::size_of::<Pair>() as u64).min(by_dispatch);
+    let pair_bytes = std::mem::size_of::<Pair>().max(2 * 4) as u64;
+    let pairs = n.saturating_mul(PAIRS_PER_BODY).max(MIN_POOL).min(binding / pair_bytes);
     let (points_per_part, snaps_per_part) = pool_part_lengths(gpu);
     let manifolds = n
         .saturating_mul(MANIFOLDS_PER_BODY)
         .max(MIN_POOL)
         .min(binding / std::mem::size_of::<ContactManifold>() as u64)
         .min(4 * points_per_part)
-        .min(2 * snaps_per_part / 2)
-        .min(by_dispatch);
+        .min(2 * snaps_per_part / 2);
     (pairs, manifolds)
 }
 

@@ -125,8 +125,8 @@ impl Gpu {
         // (the narrowphase's, the contact passes' and the body passes'),
         // about 40 us each on lavapipe (pile-1k stepped 9% faster without). The
         // step's sizes are within max_compute_workgroups_per_dimension by
-        // construction (the pools' capacities, `pair_capacities`; the listed
-        // bodies, `max_bodies`), so the check is off unless
+        // construction (the pairs and manifolds in rows, `write_dispatch` in
+        // bindings.wgsl; the listed bodies, `max_bodies`), so the check is off unless
         // WGPU_VALIDATION_INDIRECT_CALL=1 asks for it.
         let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
         descriptor.flags.remove(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);

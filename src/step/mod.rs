@@ -402,7 +402,10 @@ impl StepPipelines {
         let pipelines = Stage::ALL
             .iter()
             .flat_map(|stage| {
-                let mut constants = vec![("POOL_SPLIT", f64::from(u8::from(pool_split)))];
+                let mut constants = vec![
+                    ("POOL_SPLIT", f64::from(u8::from(pool_split))),
+                    ("DISPATCH_ROW", f64::from(gpu.limits.max_compute_workgroups_per_dimension)),
+                ];
                 if stage.scans_pairs() {
                     constants.push(("SCAN_PAIRS", 1.0));
                 }

@@ -260,3 +260,33 @@ fn a_pool_split_over_bindings_steps_to_the_same_bits() {
     assert!(report.manifold_capacity > 2 * 512 && report.manifolds_max >= 1225 && !report.overflowed(), "{report:?}");
     assert!(bits(&split) == bits(&whole), "the pool grown into parts steps differently");
 }
+
+/// The indirect dispatches over the pairs and the manifolds come in rows of
+/// at most the device's workgroups per dimension (`write_dispatch` in
+/// bindings.wgsl): a pile of a million cubes has more than 65535 x 64
+/// pairs. Made to allow 16 workgroups a dimension (rows of 1024
+/// invocations), a GPU steps a lattice of 216 balls, each overlapping its
+/// 26 neighbours (1940 pairs and manifolds: two rows), to the same bits as
+/// the GPU as it is (one row).
+#[test]
+fn the_pairs_and_manifolds_dispatched_in_rows_step_to_the_same_bits() {
+    let Some(gpu) = crate::common::gpu() else { return };
+    let mut narrow = verlet::gpu::Gpu::new().unwrap();
+    narrow.limits.max_compute_workgroups_per_dimension = 16;
+    let side = 6usize;
+    let mut scene = scenes::stack(0);
+    scene.ground = None;
+    scene.settings.gravity = [0.0; 3];
+    for k in 0..side * side * side {
+        let at = Vec3::new((k % side) as f32, ((k / side) % side) as f32, (k / side / side) as f32) * 0.55;
+        scene.bodies.push(sphere_body(0.5, at.to_array()));
+    }
+    let mut rows = World::with_gpu(std::sync::Arc::new(narrow), &scene).unwrap();
+    let mut one = World::with_gpu(gpu, &scene).unwrap();
+    rows.step(3).unwrap();
+    one.step(3).unwrap();
+    let report = rows.contact_report().unwrap();
+    eprintln!("in rows: {report:?}");
+    assert!(report.pairs_max > 1024 && report.manifolds_max > 1024 && !report.overflowed(), "{report:?}");
+    assert!(bits(&rows) == bits(&one), "the dispatches in rows step differently");
+}
