@@ -1028,7 +1028,7 @@ fn issue13_targets(report: &Report) -> Vec<Target> {
             r.gpu_bytes_per_body,
             r.gpu_bytes_at_start as f64 / r.bodies.max(1) as f64,
             report.bytes_per_body,
-            if r.contacts_overflowed { "; its contacts overflowed the pools, which stayed at their binding's limit" } else { "" }
+            if r.contacts_overflowed { "; its contacts overflowed the pools, which stayed at their limit" } else { "" }
         )
     });
     out.push(match (&report.settled, awake) {

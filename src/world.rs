@@ -119,7 +119,7 @@ impl WorldData {
                 .map(|buffer| {
                     let b = self.buffer(buffer, from);
                     // Params: one substep's slot, chosen by the dynamic offset
-                    let size = (buffer == Buffer::Params).then(|| std::mem::size_of::<Params>() as u64);
+                    let size = (buffer == Buffer::Params).then_some(std::mem::size_of::<Params>() as u64);
                     let resource = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: b,
                         offset: 0,
@@ -640,7 +640,7 @@ impl World {
     /// over. Returns whether a step of the last batch wanted more than a pool
     /// held and the pool has grown: which pairs or manifolds then found no
     /// room depended on thread timing, so the caller takes the batch again.
-    /// A pool already at its binding's limit stays, and its overflow is
+    /// A pool already at its limit (`pair_capacities`) stays, and its overflow is
     /// reported by `contact_report`. Otherwise the batch stands: its wants
     /// are added to `pools`, which may mark a pool to shrink
     /// (`SHRINK_AFTER_STEPS`), and the GPU's maxima are cleared for the next.
