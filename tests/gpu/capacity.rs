@@ -26,18 +26,11 @@ fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
 
 #[test]
 fn the_pair_pools_grow_for_a_crowded_scene() {
-    // a 13 x 13 x 13 lattice of balls 0.55 diameters apart, no gravity:
-    // every ball overlaps its 26 lattice neighbours, all of them candidates
-    // (about 10 owned pairs a body, more than the list holds at first); 2197
-    // bodies, so the pair scan spans two blocks (SCAN_SPAN)
+    // 13 x 13 x 13 balls: about 10 owned pairs a body, more than the list
+    // holds at first; 2197 bodies, so the pair scan spans two blocks
+    // (SCAN_SPAN)
     let side = 13usize;
-    let mut scene = scenes::stack(0);
-    scene.ground = None;
-    scene.settings.gravity = [0.0; 3];
-    for k in 0..side * side * side {
-        let at = Vec3::new((k % side) as f32, ((k / side) % side) as f32, (k / side / side) as f32) * 0.55;
-        scene.bodies.push(sphere_body(0.5, at.to_array()));
-    }
+    let scene = ball_lattice(side);
     let n = scene.bodies.len();
     let Some(mut w) = crate::common::world(&scene) else { return };
     let before = w.contact_report().unwrap();
@@ -129,6 +122,20 @@ fn a_body_that_owns_more_pairs_than_its_scratch_room_lists_them_all() {
     for (k, list) in contacts.iter().enumerate().skip(1).take(ring) {
         assert!(!list.is_empty() && list.iter().all(|c| c.partner == 0), "small ball {k}: {list:?}");
     }
+}
+
+/// A `side` x `side` x `side` lattice of balls 0.55 diameters apart, no
+/// ground, no gravity: every ball overlaps its 26 lattice neighbours, all of
+/// them candidate pairs.
+fn ball_lattice(side: usize) -> verlet::Scene {
+    let mut scene = scenes::stack(0);
+    scene.ground = None;
+    scene.settings.gravity = [0.0; 3];
+    for k in 0..side * side * side {
+        let at = Vec3::new((k % side) as f32, ((k / side) % side) as f32, (k / side / side) as f32) * 0.55;
+        scene.bodies.push(sphere_body(0.5, at.to_array()));
+    }
+    scene
 }
 
 /// Fifty unit boxes placed at one point 3 m up (1225 touching pairs).
@@ -273,14 +280,7 @@ fn the_pairs_and_manifolds_dispatched_in_rows_step_to_the_same_bits() {
     let Some(gpu) = crate::common::gpu() else { return };
     let mut narrow = verlet::gpu::Gpu::new().unwrap();
     narrow.limits.max_compute_workgroups_per_dimension = 16;
-    let side = 6usize;
-    let mut scene = scenes::stack(0);
-    scene.ground = None;
-    scene.settings.gravity = [0.0; 3];
-    for k in 0..side * side * side {
-        let at = Vec3::new((k % side) as f32, ((k / side) % side) as f32, (k / side / side) as f32) * 0.55;
-        scene.bodies.push(sphere_body(0.5, at.to_array()));
-    }
+    let scene = ball_lattice(6);
     let mut rows = World::with_gpu(std::sync::Arc::new(narrow), &scene).unwrap();
     let mut one = World::with_gpu(gpu, &scene).unwrap();
     rows.step(3).unwrap();
