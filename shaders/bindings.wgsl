@@ -1,6 +1,7 @@
-// The bind group every pass of the step shares (src/step/mod.rs builds its
-// layout). Two bind groups of it exist, A->B and B->A, built once; they
-// differ only in which state buffer is state_in and which state_out.
+// The step's bindings. Each pass binds those its entry point uses (its own
+// layout, src/step/mod.rs), in two bind groups, A->B and B->A, which differ
+// only in which state buffer is state_in and which state_out (made again
+// when the pools are).
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> props: array<BodyProps>;
 @group(0) @binding(2) var<storage, read> state_in: array<BodyState>;
@@ -41,10 +42,11 @@
 // lowest body found bad in the first step that found any, and that step's
 // step_index, both atomicMin-ed from NO_FAULT (0xffffffff, written when the
 // buffer is made); status[8..11]: the narrowphase's indirect dispatch
-// (workgroups over the pairs, 1, 1), copied out before it runs;
+// (workgroups over the pairs in rows, rows, 1: write_dispatch), copied out
+// before it runs;
 // status[11]: 1 if a grid body sleeps this step (grid_count sets it,
 // contact_lists clears it: the pair walks read it, see pairs.wgsl);
-// status[12..15]: the contact passes' (workgroups over the manifolds, 1, 1),
+// status[12..15]: the contact passes' (over the manifolds, in rows alike),
 // written by contact_lists and copied out after it; status[15]: 1 if a
 // body moves or is due to wake after the step (integrate sets it, grid_count
 // clears it: with 0 after a batch the world is at rest, and the host skips
@@ -133,11 +135,12 @@ fn pool_slot(k: u32, used: u32) -> u32 {
 // in part k / P at k % P, P the first part's length (every part but the
 // last is full; a part not needed holds one entry and is never read). The
 // manifold passes run over consecutive slots, so the lanes of a vector
-// take the same part but where one part ends. A pool within one part (every
-// scene but the largest) is read and written with POOL_SPLIT off, which
-// folds every access below to one load or store with no branch (the
-// branches cost the contact passes a sixth of their time); World's
-// make_pools compiles the passes again with it on once a pool needs parts.
+// take the same part but where one part ends. Until a pool first needs
+// parts (every scene but the largest never does) the passes run with
+// POOL_SPLIT off, which folds every access below to one load or store with
+// no branch (the branches cost the contact passes a sixth of their time);
+// World's make_pools compiles the passes that touch the parts again with
+// it on then, and they stay so (right at any size).
 override POOL_SPLIT: bool = false;
 
 // Where slot k's points lie: (part, index in it).

@@ -338,7 +338,7 @@ fn sleeps_held(i: u32) -> bool {
 // Where contact reference r goes in its body's list: pairs the body does not
 // own (it is end b) first, then owned ones, each by pair index (the owner
 // writes its pairs in walk order; a pair index stays below 2^31, see
-// world.rs's capacity).
+// world.rs's pair_capacities).
 fn list_order(r: u32) -> u32 {
     return manifolds[r >> 1u].pair | select(0x80000000u, 0u, (r & 1u) != 0u);
 }

@@ -297,16 +297,22 @@ pub const MANIFOLDS_PER_BODY: u64 = 3;
 pub fn pair_capacities(gpu: &Gpu, n: u64) -> (u64, u64) {
     let binding = binding_limit(gpu);
     let pair_bytes = std::mem::size_of::<Pair>().max(2 * 4) as u64;
-    let pairs = n.saturating_mul(PAIRS_PER_BODY).max(MIN_POOL).min(binding / pair_bytes);
+    let pairs = n.saturating_mul(PAIRS_PER_BODY).max(MIN_POOL).min(binding / pair_bytes).min(MAX_INDEX);
     let (points_per_part, snaps_per_part) = pool_part_lengths(gpu);
     let manifolds = n
         .saturating_mul(MANIFOLDS_PER_BODY)
         .max(MIN_POOL)
         .min(binding / std::mem::size_of::<ContactManifold>() as u64)
         .min(4 * points_per_part)
-        .min(2 * snaps_per_part / 2);
+        .min(2 * snaps_per_part / 2)
+        .min(MAX_INDEX);
     (pairs, manifolds)
 }
+
+/// Most pairs, and most manifolds, whatever the bindings hold: a pair's
+/// index keeps the top bit free (`list_order` in narrowphase.wgsl), and a
+/// manifold's contact references (2 x slot + 1) fit 32 bits.
+const MAX_INDEX: u64 = 1 << 31;
 
 /// Most entries a part of the pool's points and of its snaps holds: one
 /// storage binding's worth (bindings.wgsl's `point_of`, `snap_of`).
@@ -756,7 +762,7 @@ impl World {
         self.gpu.queue.submit([encoder.finish()]);
         if pool_in_parts(&self.gpu, manifolds) && !self.pipelines.pool_split {
             // once, for the largest scenes: the passes read and write the parts
-            self.pipelines = StepPipelines::new(&self.gpu, true);
+            self.pipelines.split_pool(&self.gpu);
         }
         self.data.bind_groups = Some(self.data.step_bind_groups(device, &self.pipelines));
         self.gpu.check()?;
@@ -1276,7 +1282,7 @@ fn binding_limit(gpu: &Gpu) -> u64 {
 /// The most bodies this GPU can hold: the poses must fit one storage
 /// binding, the hash table (up to four buckets per body after rounding to a
 /// power of two) too, and a dispatch has a workgroup limit. The pair list
-/// and the manifold pool are sized to fit one binding each (see
+/// and the manifold pool grow within their bindings (see
 /// `pair_capacities`); a pool too small for a scene is reported.
 pub fn max_bodies(gpu: &Gpu) -> u64 {
     let per_binding = binding_limit(gpu);

@@ -18,7 +18,7 @@
 //! read one state buffer and write the other, so the current state flips
 //! after each of them; the `*_contacts` passes write only the manifolds'
 //! snaps and friction budgets. This type holds
-//! only compiled pipelines and their layout; the buffers live in `World`.
+//! only compiled pipelines and their layouts; the buffers live in `World`.
 
 use crate::gpu::{shaders, types::*, Gpu};
 
@@ -387,6 +387,20 @@ fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry { binding: buffer.binding(), visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
 }
 
+/// Compiles one pass with its layout (the override constants: POOL_SPLIT,
+/// DISPATCH_ROW from the device's limits, SCAN_PAIRS for the pairs' scan).
+fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: bool) -> wgpu::ComputePipeline {
+    let mut constants = vec![
+        ("POOL_SPLIT", f64::from(u8::from(pool_split))),
+        ("DISPATCH_ROW", f64::from(gpu.limits.max_compute_workgroups_per_dimension)),
+    ];
+    if stage.scans_pairs() {
+        constants.push(("SCAN_PAIRS", 1.0));
+    }
+    let mut one = gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), &constants);
+    one.remove(0)
+}
+
 impl StepPipelines {
     /// Compiles the step's passes, for a manifold pool in parts where
     /// `pool_split` (see `World::make_pools`).
@@ -399,21 +413,20 @@ impl StepPipelines {
                 device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(stage.name()), entries: &entries })
             })
             .collect();
-        let pipelines = Stage::ALL
-            .iter()
-            .flat_map(|stage| {
-                let mut constants = vec![
-                    ("POOL_SPLIT", f64::from(u8::from(pool_split))),
-                    ("DISPATCH_ROW", f64::from(gpu.limits.max_compute_workgroups_per_dimension)),
-                ];
-                if stage.scans_pairs() {
-                    constants.push(("SCAN_PAIRS", 1.0));
-                }
-                let layout = &layouts[*stage as usize];
-                gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), &constants)
-            })
-            .collect();
+        let pipelines = Stage::ALL.iter().map(|&stage| compile(gpu, stage, &layouts[stage as usize], pool_split)).collect();
         StepPipelines { layouts, pipelines, pool_split }
+    }
+
+    /// Compiles the passes that touch the manifold pool's parts again, for
+    /// a pool in parts (POOL_SPLIT on; see `World::make_pools`).
+    pub fn split_pool(&mut self, gpu: &Gpu) {
+        for stage in Stage::ALL {
+            let buffers = stage.buffers();
+            if buffers.contains(&Buffer::Points) || buffers.contains(&Buffer::Snaps1) {
+                self.pipelines[stage as usize] = compile(gpu, stage, &self.layouts[stage as usize], true);
+            }
+        }
+        self.pool_split = true;
     }
 
     pub fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {
