@@ -16,6 +16,8 @@
 // written once when the world is made) the bodies kept out of the grid;
 // from body_count on, the step's listed bodies (see `listed_body`)
 @group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // 2 x body_count
+// the grid bodies' bounds in sorted's order (CellBound)
+@group(0) @binding(22) var<storage, read_write> cell_bounds: array<CellBound>;  // body_count
 // the pair pipeline (pairs.wgsl, narrowphase.wgsl): candidate pairs, each
 // found once; the manifold pool, filled by need; each body's pair list,
 // body i's at body_pairs[pair_meta[i].list_start ..][.. pair_meta[i].total],

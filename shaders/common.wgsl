@@ -191,6 +191,22 @@ struct PairMeta {
     reach: f32,
 }
 
+// A grid body's bounds in the grid's order, as the pair walks read them
+// (grid_sort writes them; pairs.wgsl): its centre, its bounds (pair_meta's
+// bound and extent) and its index with pair_meta's moves in the top two
+// bits. One record a candidate, the bodies of a cell side by side: the
+// walks read their candidates' bounds from state_in and pair_meta before,
+// two records of 64 bytes apart. 32 bytes.
+struct CellBound {
+    pos: vec3<f32>,
+    bound: f32,
+    extent: vec3<f32>,
+    body: u32,
+}
+
+const BODY_BITS: u32 = 0x3fffffffu;
+const MOVES_SHIFT: u32 = 30u;
+
 // pair_meta[i].moves (grid_count): contacts can move the body this step
 // (awake, or asleep but woken by the last step's narrowphase); it sleeps
 // (and its pairs are found by the bodies that move: pairs.wgsl); it is

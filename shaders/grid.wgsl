@@ -10,7 +10,8 @@
 //                     alone: pairs_write adds the pairs' own)
 //   grid_scatter      bodies:  sorted[cell_end - count--] = body
 //   grid_sort         buckets: sort each bucket's bodies by the low x side of
-//                     their bounds, then index (the pair walks stop early)
+//                     their bounds, then index (the pair walks stop early),
+//                     and write their bounds in that order (cell_bounds)
 //
 // The scatter counts each bucket back down to 0, so the counts are 0 again
 // for the next step without a pass to clear them (a new buffer is zeroed).
@@ -271,7 +272,9 @@ fn sorts_before(a: u32, b: u32) -> bool {
 // The scatter's order within a bucket depends on thread timing; sorting each
 // bucket (by key, then index) makes every later pass see the same order
 // every run, and lets a pair walk stop at the first body of a cell whose
-// box begins beyond the walker's reach along x (see pairs.wgsl).
+// box begins beyond the walker's reach along x (see pairs.wgsl). The
+// bucket's bodies' bounds then go to cell_bounds in that order, where the
+// walks read a cell's candidates side by side (CellBound).
 @compute @workgroup_size(WORKGROUP)
 fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
@@ -288,5 +291,9 @@ fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
             m = m - 1u;
         }
         sorted[m] = v;
+    }
+    for (var k = start; k < end; k = k + 1u) {
+        let i = sorted[k];
+        cell_bounds[k] = CellBound(state_in[i].pos, pair_meta[i].bound, pair_meta[i].extent, i | (pair_meta[i].moves << MOVES_SHIFT));
     }
 }

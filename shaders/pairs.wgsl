@@ -61,7 +61,7 @@ fn joined_to_walker(j: u32) -> bool {
 // displacement over the last substep, rescaled to the step, plus what
 // gravity adds (to a body against one that stays), and never more than
 // how far both may move (PairMeta's reach, which the candidate test,
-// `wanted`, grows the bounds by). Bodies that fall or slide together keep
+// `wanted_bounds`, grows the bounds by). Bodies that fall or slide together keep
 // their gap: in a 10k pile of falling cubes the busiest step's manifolds
 // went from 28.4k to 23.0k, and the contact passes took 7-21% less time
 // (the reaches' sum made a speculative contact of every pair of
@@ -77,24 +77,27 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
     return CONTACT_MARGIN + min(relative, pair_meta[lo].reach + pair_meta[hi].reach);
 }
 
-// Whether the walking body and body j (at pos_j; not the walker) form a
-// candidate pair: one of them moves, their bounds (bounding spheres and
-// world boxes, grown by their reach) come within CONTACT_MARGIN, and they
-// are not joined. The spheres cut the corners of the boxes: in a 10k pile
-// of tumbling cubes they cut the candidate pairs of the busiest step from
+// Whether the walking body and body j (not the walker) form a candidate
+// pair: one of them moves, their bounds (bounding spheres and world boxes,
+// grown by their reach) come within CONTACT_MARGIN, and they are not
+// joined. The spheres cut the corners of the boxes: in a 10k pile of
+// tumbling cubes they cut the candidate pairs of the busiest step from
 // 81.9k to 44.6k, and by 8-17% once the pile has landed. (Every sum here is
 // of one term of each body, so it is the same bits whichever body walks.)
-fn wanted(j: u32, pos_j: vec3<f32>) -> bool {
-    if (!walker.moves && pair_meta[j].moves != MOVES) {
+// `wanted_bounds` is all but the joints, on j's centre, bounds and moves
+// as given (from cell_bounds, or from state_in and pair_meta: the same
+// values).
+fn wanted_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u32) -> bool {
+    if (!walker.moves && moves_j != MOVES) {
         return false;
     }
     let d = walker.pos - pos_j;
-    let spheres = walker.bound + pair_meta[j].bound + CONTACT_MARGIN;
+    let spheres = walker.bound + bound_j + CONTACT_MARGIN;
     if (dot(d, d) > spheres * spheres) {
         return false;
     }
-    let apart = abs(d) - walker.extent - pair_meta[j].extent;
-    return all(apart <= vec3<f32>(CONTACT_MARGIN)) && !joined_to_walker(j);
+    let apart = abs(d) - walker.extent - extent_j;
+    return all(apart <= vec3<f32>(CONTACT_MARGIN));
 }
 
 // Whether body i is near enough the ground for a ground pair.
@@ -144,11 +147,10 @@ fn write_owned(j: u32) {
     }
 }
 
-// Body j (at pos_j), whose pair with this body the walk owns.
-fn visit(j: u32, pos_j: vec3<f32>) {
-    if (!wanted(j, pos_j)) {
-        return;
-    }
+// Body j, whose pair with this body the walk owns, once wanted: written
+// (pairs_write), or noted in the room and counted into j's incoming pairs
+// (pairs_count).
+fn take(j: u32) {
     if (writing) {
         write_owned(j);
     } else {
@@ -165,27 +167,28 @@ fn visit(j: u32, pos_j: vec3<f32>) {
 // in one ahead of it every body; up to the first whose box begins beyond
 // the walker's along x by more than the margin: a bucket is sorted by
 // where its boxes begin (grid_sort), so no later one can be wanted either.
-// (`wanted` decides, with its own roundings; the stop keeps a slack of
-// 1e-4 m and 1e-5 of the position.)
+// (`wanted_bounds` decides, with its own roundings; the stop keeps a
+// slack of 1e-4 m and 1e-5 of the position.) The candidates' bounds come
+// from cell_bounds, by their place in the grid (grid_sort).
 fn visit_cell(c: vec3<i32>, above: u32, behind: bool) {
     let h = bucket_of(c);
     let end = cell_start[h + 1u];
     let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
     for (var k = cell_start[h]; k < end; k = k + 1u) {
-        let j = sorted[k];
-        let pos_j = state_in[j].pos;
-        if (pos_j.x - pair_meta[j].extent.x > stop) {
+        let cb = cell_bounds[k];
+        if (cb.pos.x - cb.extent.x > stop) {
             break;
         }
+        let j = cb.body & BODY_BITS;
+        let moves_j = cb.body >> MOVES_SHIFT;
         // a cell ahead: every body; the own cell: those of higher index, and
-        // of the others the sleepers; a cell behind: the sleepers (read only
-        // then: a load a candidate is what the walk costs)
+        // of the others the sleepers; a cell behind: the sleepers
         var takes = above == NONE || j > above;
         if (!takes || behind) {
-            takes = pair_meta[j].moves == SLEEPS;
+            takes = moves_j == SLEEPS;
         }
-        if (takes && all(cell_of(pos_j) == c)) {
-            visit(j, pos_j);
+        if (takes && all(cell_of(cb.pos) == c) && wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j) && !joined_to_walker(j)) {
+            take(j);
         }
     }
 }
@@ -246,8 +249,9 @@ fn walk(i: u32) {
     }
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         let j = large_body(k);
-        if (grid || j > i) {
-            visit(j, state_in[j].pos);
+        if ((grid || j > i) && wanted_bounds(state_in[j].pos, pair_meta[j].bound, pair_meta[j].extent, pair_meta[j].moves)
+            && !joined_to_walker(j)) {
+            take(j);
         }
     }
 }

@@ -67,8 +67,8 @@ struct WorldData {
     /// joint lists (the snapshot's scene hash reads them all).
     statics: [wgpu::Buffer; 3],
     /// Working buffers of the passes: vel0, and the grid's cell_count,
-    /// cell_start, block_sums and sorted.
-    scratch: [wgpu::Buffer; 5],
+    /// cell_start, block_sums, sorted and cell_bounds.
+    scratch: [wgpu::Buffer; 6],
     /// What a batch of steps starts from (the state and `status`; nothing
     /// else carries over from one step to the next, see snapshot.rs),
     /// copied as each batch begins, so that a batch during which a pool
@@ -81,7 +81,7 @@ impl WorldData {
     /// The buffer bound at `buffer`'s binding while `states[from]` is the
     /// current state (state_in) and the other the next (state_out).
     fn buffer(&self, buffer: Buffer, from: usize) -> &wgpu::Buffer {
-        let [vel0, cell_count, cell_start, block_sums, sorted] = &self.scratch;
+        let [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds] = &self.scratch;
         let [_, joint_start, joint_refs] = &self.statics;
         match buffer {
             Buffer::Params => &self.params,
@@ -106,6 +106,7 @@ impl WorldData {
             Buffer::JointRefs => joint_refs,
             Buffer::PairMeta => &self.pair_meta,
             Buffer::BodyPairs => &self.body_pairs,
+            Buffer::CellBounds => cell_bounds,
         }
     }
 
@@ -353,13 +354,13 @@ pub fn bytes_per_body() -> u64 {
 
 /// Bytes of GPU memory a body holds whatever it touches: poses (two
 /// buffers), properties, velocities, its pair bookkeeping, the grid's share
-/// (sorted list, about two hash buckets with their counts and starts), its
-/// place in the list of bodies the body passes run over, and
-/// the copy of the pose a batch of steps starts from.
+/// (sorted list, its bounds in that order, about two hash buckets with
+/// their counts and starts), its place in the list of bodies the body
+/// passes run over, and the copy of the pose a batch of steps starts from.
 pub fn body_bytes() -> u64 {
     let state = std::mem::size_of::<BodyState>() as u64;
     let meta = std::mem::size_of::<PairMeta>() as u64;
-    let grid = 2 * 4 + 2 * 8;
+    let grid = 2 * 4 + std::mem::size_of::<CellBound>() as u64 + 2 * 8;
     3 * state + std::mem::size_of::<BodyProps>() as u64 + std::mem::size_of::<Velocity>() as u64 + meta + grid
 }
 
@@ -458,6 +459,8 @@ impl World {
         let block_sums = storage("scan/block_sums", 8 * hash.max(count as u64).div_ceil(SCAN_SPAN as u64));
         // the grid's order, then the step's listed bodies (`listed_body` in bindings.wgsl)
         let sorted = storage("grid/sorted", 8 * count as u64);
+        // the grid bodies' bounds in the grid's order (grid_sort, for the pair walks)
+        let cell_bounds = storage("grid/cell_bounds", (count * std::mem::size_of::<CellBound>()) as u64);
         let large_buf = with_data("grid/large", bytemuck::cast_slice(&large));
         let (pair_capacity, manifold_capacity) = pair_capacities(&gpu, count as u64);
         let pairs = storage("pairs", pair_capacity * std::mem::size_of::<Pair>() as u64);
@@ -500,7 +503,7 @@ impl World {
             bind_groups: None,
             props: props_buf,
             statics: [large_buf, joint_start, joint_refs],
-            scratch: [vel0, cell_count, cell_start, block_sums, sorted],
+            scratch: [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds],
             batch_start: [storage("batch start/state", state_bytes), storage("batch start/status", STATUS_BYTES)],
         };
         data.bind_groups = Some(data.step_bind_groups(device, &pipelines));

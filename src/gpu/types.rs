@@ -180,6 +180,21 @@ pub struct EndSnap {
     pub flags: u32,
 }
 
+/// A grid body's bounds as the pair walks read them, in the grid's order
+/// (32 bytes); see `CellBound` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CellBound {
+    /// Centre (m).
+    pub pos: [f32; 3],
+    /// Bounding radius grown by the reach (m).
+    pub bound: f32,
+    /// Half extents of the world box grown by the reach (m).
+    pub extent: [f32; 3],
+    /// The body's index, and in the top two bits `PairMeta::moves`.
+    pub body: u32,
+}
+
 /// A body's pair bookkeeping (64 bytes); see `PairMeta` in common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

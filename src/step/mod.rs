@@ -101,10 +101,11 @@ pub enum Buffer {
     Points2 = 19,
     Points3 = 20,
     Snaps1 = 21,
+    CellBounds = 22,
 }
 
 impl Buffer {
-    pub const ALL: [Buffer; 22] = [
+    pub const ALL: [Buffer; 23] = [
         Buffer::Params,
         Buffer::Props,
         Buffer::StateIn,
@@ -127,6 +128,7 @@ impl Buffer {
         Buffer::Points2,
         Buffer::Points3,
         Buffer::Snaps1,
+        Buffer::CellBounds,
     ];
 
     pub fn binding(self) -> u32 {
@@ -239,11 +241,12 @@ impl Stage {
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
             Stage::GridSort => &[Params, StateIn, CellStart, Sorted, PairMeta],
             Stage::PairsCount => {
-                &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs]
+                &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs, CellBounds]
             }
-            Stage::PairsWrite => {
-                &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs]
-            }
+            Stage::PairsWrite => &[
+                Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs,
+                CellBounds,
+            ],
             Stage::Narrowphase | Stage::NarrowphaseGround => {
                 &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs, Points]
             }
@@ -271,7 +274,7 @@ impl Stage {
             Stage::GridScanSums | Stage::PairsScanSums => &[CellStart, BlockSums, Status, PairMeta],
             Stage::GridScanAdd => &[CellStart],
             Stage::GridScatter => &[CellCount, Sorted],
-            Stage::GridSort => &[Sorted],
+            Stage::GridSort => &[Sorted, CellBounds],
             Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
             Stage::Narrowphase | Stage::NarrowphaseGround => {
                 &[Manifolds, Status, PairMeta, BodyPairs, Points, Points1, Points2, Points3]

@@ -67,6 +67,7 @@ fn shared_structs_match_member_by_member() {
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, body });
     check_layout!(common, Pair { a, b });
+    check_layout!(common, CellBound { pos, bound, extent, body });
     check_layout!(common, ContactPoint { local_a, pushed, local_b, _pad0 });
     check_layout!(common, ContactManifold { normal, count, a, b, clip_face, pair });
     check_layout!(common, ManifoldPoints { at });
