@@ -191,7 +191,9 @@ pub struct CellBound {
     pub bound: f32,
     /// Half extents of the world box grown by the reach (m).
     pub extent: [f32; 3],
-    /// The body's index, and in the top two bits `PairMeta::moves`.
+    /// The body's index, and in the top two bits `PairMeta::moves` (an
+    /// index fits 30 bits: a binding holds at most 4 GiB, and a body's
+    /// state takes 64 bytes of one, so no world has 2^26 bodies).
     pub body: u32,
 }
 
