@@ -21,7 +21,9 @@
 //!    kernel reading and writing 64 bytes per body, timed like the passes)
 //!    as the physical floor of the integration pass;
 //! 5. **peer** (feature `rapier`): the identical scene stepped the same
-//!    number of steps by rapier3d on the CPU, timed the same way.
+//!    number of steps by rapier3d on the CPU, timed the same way, one of
+//!    its repetitions after each of ours (a machine whose speed drifts
+//!    during a case weighs on both engines alike).
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -735,7 +737,10 @@ fn run_case(
         out.first_step_ms
     );
 
-    // 2. repetitions from the same initial state
+    // 2. repetitions from the same initial state, each followed by one of
+    // the peer's (so that a machine whose speed drifts during the case
+    // weighs on both engines alike)
+    let mut peer = PeerReps::new(&case, &scene, steps, reps, opts);
     let mut setups = Vec::new();
     let mut last = None;
     for r in 0..reps {
@@ -753,6 +758,9 @@ fn run_case(
         out.ms_per_step.push(ms);
         progress!("{}: rep {}/{reps}: {ms:.3} ms/step", case.name, r + 1);
         last = Some(world);
+        if let Some(p) = peer.as_mut() {
+            p.rep(r);
+        }
     }
     let mut world = last.expect("reps >= 1");
     out.setup_s = median(&setups);
@@ -792,50 +800,87 @@ fn run_case(
         out.gpu_bytes_per_body
     );
 
-    // 5. the peer
-    out.peer = run_peer(&case, &scene, steps, reps, out.median_ms_per_step, opts);
+    // 5. the peer's repetitions, taken between ours
+    out.peer = peer.map(|p| p.result(out.median_ms_per_step));
     Ok(out)
 }
 
+/// The peer's repetitions of one case (feature `rapier`), taken one at a
+/// time between ours: each a fresh rapier3d world of the same scene, its
+/// first step untimed, then the same steps timed.
 #[cfg(feature = "rapier")]
-fn run_peer(case: &Case, scene: &Scene, steps: u64, reps: usize, ours_ms: f64, opts: &Options) -> Option<PeerResult> {
-    if opts.no_peer || opts.peer_max_bodies.is_some_and(|m| scene.bodies.len() > m) {
-        return None;
-    }
-    let mut times = Vec::new();
-    let mut setups = Vec::new();
-    let mut last = None;
-    for r in 0..reps {
-        let t = Instant::now();
-        let mut w = peer::RapierWorld::new(scene, opts.rapier_sleeping, opts.rapier_iterations);
-        w.step(1); // as ours: the first step untimed, the same steps timed
-        setups.push(t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        w.step(steps);
-        let ms = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
-        progress!("{}: rapier rep {}/{reps}: {ms:.3} ms/step", case.name, r + 1);
-        times.push(ms);
-        last = Some(w);
-    }
-    let w = last?;
-    let m = median(&times);
-    Some(PeerResult {
-        engine: peer::ENGINE.into(),
-        threads: if peer::PARALLEL { "rayon".into() } else { "1".into() },
-        sleeping: opts.rapier_sleeping,
-        num_solver_iterations: w.num_solver_iterations(),
-        setup_s: median(&setups),
-        ms_per_step: times,
-        median_ms_per_step: m,
-        body_steps_per_s: scene.bodies.len() as f64 / (m * 1e-3),
-        speedup: m / ours_ms,
-        mean_height: w.mean_height(),
-    })
+struct PeerReps<'a> {
+    case: &'a Case,
+    scene: &'a Scene,
+    steps: u64,
+    reps: usize,
+    opts: &'a Options,
+    times: Vec<f64>,
+    setups: Vec<f64>,
+    last: Option<peer::RapierWorld>,
 }
 
+#[cfg(feature = "rapier")]
+impl<'a> PeerReps<'a> {
+    /// None when the peer is not run (`--no-peer`, or more bodies than
+    /// `--peer-max-bodies`).
+    fn new(case: &'a Case, scene: &'a Scene, steps: u64, reps: usize, opts: &'a Options) -> Option<PeerReps<'a>> {
+        if opts.no_peer || opts.peer_max_bodies.is_some_and(|m| scene.bodies.len() > m) {
+            return None;
+        }
+        Some(PeerReps { case, scene, steps, reps, opts, times: Vec::new(), setups: Vec::new(), last: None })
+    }
+
+    /// Repetition `r` (from 0).
+    fn rep(&mut self, r: usize) {
+        let t = Instant::now();
+        let mut w = peer::RapierWorld::new(self.scene, self.opts.rapier_sleeping, self.opts.rapier_iterations);
+        w.step(1); // as ours: the first step untimed, the same steps timed
+        self.setups.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        w.step(self.steps);
+        let ms = t.elapsed().as_secs_f64() * 1e3 / self.steps as f64;
+        progress!("{}: rapier rep {}/{}: {ms:.3} ms/step", self.case.name, r + 1, self.reps);
+        self.times.push(ms);
+        self.last = Some(w);
+    }
+
+    /// The peer's result against our median `ours_ms`.
+    fn result(self, ours_ms: f64) -> PeerResult {
+        let m = median(&self.times);
+        let w = self.last.as_ref();
+        PeerResult {
+            engine: peer::ENGINE.into(),
+            threads: if peer::PARALLEL { "rayon".into() } else { "1".into() },
+            sleeping: self.opts.rapier_sleeping,
+            num_solver_iterations: w.map_or(0, |w| w.num_solver_iterations()),
+            setup_s: median(&self.setups),
+            ms_per_step: self.times,
+            median_ms_per_step: m,
+            body_steps_per_s: self.scene.bodies.len() as f64 / (m * 1e-3),
+            speedup: m / ours_ms,
+            mean_height: w.map_or(f64::NAN, |w| w.mean_height()),
+        }
+    }
+}
+
+/// Without the feature there is no peer: no value of this type exists.
 #[cfg(not(feature = "rapier"))]
-fn run_peer(_: &Case, _: &Scene, _: u64, _: usize, _: f64, _: &Options) -> Option<PeerResult> {
-    None
+enum PeerReps {}
+
+#[cfg(not(feature = "rapier"))]
+impl PeerReps {
+    fn new(_: &Case, _: &Scene, _: u64, _: usize, _: &Options) -> Option<PeerReps> {
+        None
+    }
+
+    fn rep(&mut self, _: usize) {
+        match *self {}
+    }
+
+    fn result(self, _: f64) -> PeerResult {
+        match self {}
+    }
 }
 
 /// Fits the exponent over the cases of `scene` with 10 000 bodies and more.
