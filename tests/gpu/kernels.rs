@@ -5,7 +5,7 @@
 use crate::common::world;
 use crate::common::Rng;
 use glam::{Quat, Vec3};
-use verlet::gpu::types::{PairMeta, SCAN_SPAN};
+use verlet::gpu::types::{CellBound, PairMeta, SCAN_SPAN};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
 use verlet::world::plan_grid;
@@ -25,7 +25,8 @@ fn grid_stages() -> Vec<Stage> {
 /// (grid.wgsl's bucket_of), within a bucket by the low x side of their
 /// bounds (grid_key: centre less pair_meta's extent), then index, the bodies
 /// kept out of the grid at the tail; cell_start holds the buckets' prefix
-/// sums. With 2500 bodies the scan spans four blocks; with 600 it is one
+/// sums, and `cell_bounds` each grid body's bounds at its place in
+/// `sorted`. With 2500 bodies the scan spans four blocks; with 600 it is one
 /// block, which its first pass finishes (the second and third are left out).
 #[test]
 fn the_grid_is_a_counting_sort_by_bucket() {
@@ -39,7 +40,10 @@ fn grid_sort_matches_a_counting_sort(n: usize) {
     let mut bodies = Vec::new();
     for k in 0..n {
         let at = [40.0 * rng.f() - 20.0, 30.0 * rng.f() - 5.0, 40.0 * rng.f() - 20.0];
-        bodies.push(if k % 3 == 0 { sphere_body(0.2 + 0.3 * rng.f(), at) } else { box_body([0.3, 0.2 + 0.2 * rng.f(), 0.4], at) });
+        let mut b = if k % 3 == 0 { sphere_body(0.2 + 0.3 * rng.f(), at) } else { box_body([0.3, 0.2 + 0.2 * rng.f(), 0.4], at) };
+        // some fixed, for cell_bounds' moves (STAYS_FIXED, 0, beside MOVES)
+        b.fixed = k % 7 == 0;
+        bodies.push(b);
     }
     let blocks = plan_grid(&vec![0.5; n + 2]).1.hash_size.div_ceil(SCAN_SPAN);
     assert_eq!(blocks, if n > 1024 { 4 } else { 1 });
@@ -91,6 +95,19 @@ fn grid_sort_matches_a_counting_sort(n: usize) {
         starts[h + 1] += starts[h];
     }
     assert_eq!(cell_start[..starts.len()], starts[..], "cell_start");
+    // cell_bounds: each grid body's centre, bounds, index and moves at its
+    // place in sorted, copied bit for bit from state_in and pair_meta
+    let bounds = w.read_words(Buffer::CellBounds).unwrap();
+    let record = std::mem::size_of::<CellBound>() / 4;
+    let word = |i: usize, field: usize| meta[stride * i + field / 4];
+    for (k, &i) in sorted[..n].iter().enumerate() {
+        let i = i as usize;
+        let mut want: Vec<u32> = states[i].pos.iter().map(|v| v.to_bits()).collect();
+        want.push(word(i, std::mem::offset_of!(PairMeta, bound)));
+        want.extend((0..3).map(|c| word(i, std::mem::offset_of!(PairMeta, extent) + 4 * c)));
+        want.push(i as u32 | word(i, std::mem::offset_of!(PairMeta, moves)) << 30);
+        assert_eq!(&bounds[record * k..record * (k + 1)], &want[..], "cell_bounds[{k}] (body {i})");
+    }
 }
 
 /// integrate carries a free body's displacement and adds g h^2 (eq. 6 with
