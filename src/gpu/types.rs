@@ -193,7 +193,7 @@ pub struct CellBound {
     pub extent: [f32; 3],
     /// The body's index, and in the top two bits `PairMeta::moves` (an
     /// index fits 30 bits: a binding holds at most 4 GiB, and a body's
-    /// state takes 64 bytes of one, so no world has 2^26 bodies).
+    /// state takes 64 bytes of one, so no world has more than 2^26 bodies).
     pub body: u32,
 }
 
