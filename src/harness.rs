@@ -817,7 +817,9 @@ struct PeerReps<'a> {
     opts: &'a Options,
     times: Vec<f64>,
     setups: Vec<f64>,
-    last: Option<peer::RapierWorld>,
+    /// The last repetition's solver iterations and mean height (its world
+    /// is dropped at once: ours are stepped and profiled meanwhile).
+    last: Option<(usize, f64)>,
 }
 
 #[cfg(feature = "rapier")]
@@ -842,24 +844,24 @@ impl<'a> PeerReps<'a> {
         let ms = t.elapsed().as_secs_f64() * 1e3 / self.steps as f64;
         progress!("{}: rapier rep {}/{}: {ms:.3} ms/step", self.case.name, r + 1, self.reps);
         self.times.push(ms);
-        self.last = Some(w);
+        self.last = Some((w.num_solver_iterations(), w.mean_height()));
     }
 
     /// The peer's result against our median `ours_ms`.
     fn result(self, ours_ms: f64) -> PeerResult {
         let m = median(&self.times);
-        let w = self.last.as_ref();
+        let (iterations, height) = self.last.unwrap_or((0, f64::NAN));
         PeerResult {
             engine: peer::ENGINE.into(),
             threads: if peer::PARALLEL { "rayon".into() } else { "1".into() },
             sleeping: self.opts.rapier_sleeping,
-            num_solver_iterations: w.map_or(0, |w| w.num_solver_iterations()),
+            num_solver_iterations: iterations,
             setup_s: median(&self.setups),
             ms_per_step: self.times,
             median_ms_per_step: m,
             body_steps_per_s: self.scene.bodies.len() as f64 / (m * 1e-3),
             speedup: m / ours_ms,
-            mean_height: w.map_or(f64::NAN, |w| w.mean_height()),
+            mean_height: height,
         }
     }
 }

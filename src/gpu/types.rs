@@ -192,8 +192,7 @@ pub struct CellBound {
     /// Half extents of the world box grown by the reach (m).
     pub extent: [f32; 3],
     /// The body's index, and in the top two bits `PairMeta::moves` (an
-    /// index fits 30 bits: a binding holds at most 4 GiB, and a body's
-    /// state takes 64 bytes of one, so no world has more than 2^26 bodies).
+    /// index fits 30 bits: `world::max_bodies` holds worlds below 2^30).
     pub body: u32,
 }
 
