@@ -204,9 +204,6 @@ struct CellBound {
     body: u32,
 }
 
-const BODY_BITS: u32 = 0x3fffffffu;
-const MOVES_SHIFT: u32 = 30u;
-
 // pair_meta[i].moves (grid_count): contacts can move the body this step
 // (awake, or asleep but woken by the last step's narrowphase); it sleeps
 // (and its pairs are found by the bodies that move: pairs.wgsl); it is

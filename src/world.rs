@@ -1287,11 +1287,11 @@ fn binding_limit(gpu: &Gpu) -> u64 {
 /// power of two) too, and a dispatch has a workgroup limit. The pair list
 /// and the manifold pool grow within their bindings (see
 /// `pair_capacities`); a pool too small for a scene is reported. A body's
-/// index must also fit the 30 bits `CellBound::body` keeps for it.
+/// index must also fit the bits `CellBound::body` keeps for it.
 pub fn max_bodies(gpu: &Gpu) -> u64 {
     let per_binding = binding_limit(gpu);
     let by_state = per_binding / std::mem::size_of::<BodyState>() as u64;
     let by_hash = per_binding / 16;
     let by_groups = gpu.limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64 / 4;
-    by_state.min(by_hash).min(by_groups).min(1 << 30)
+    by_state.min(by_hash).min(by_groups).min(BODY_BITS as u64 + 1)
 }

@@ -35,6 +35,8 @@ pub fn shared_constants() -> String {
         ("SCAN_RUN", SCAN_RUN),
         ("SCAN_SPAN", SCAN_SPAN),
         ("WOKEN_NOW", WOKEN_NOW),
+        ("BODY_BITS", BODY_BITS),
+        ("MOVES_SHIFT", MOVES_SHIFT),
         ("NO_FAULT", NO_FAULT),
         ("FAULT_NON_FINITE", FaultKind::NonFinite as u32),
         ("FAULT_FAR", FaultKind::TooFar as u32),

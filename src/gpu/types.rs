@@ -180,6 +180,11 @@ pub struct EndSnap {
     pub flags: u32,
 }
 
+/// `CellBound::body`: the body's index in the low bits (`BODY_BITS`),
+/// `PairMeta::moves` from bit `MOVES_SHIFT` on (shared with WGSL).
+pub const MOVES_SHIFT: u32 = 30;
+pub const BODY_BITS: u32 = (1 << MOVES_SHIFT) - 1;
+
 /// A grid body's bounds as the pair walks read them, in the grid's order
 /// (32 bytes); see `CellBound` in common.wgsl.
 #[repr(C)]
@@ -192,7 +197,7 @@ pub struct CellBound {
     /// Half extents of the world box grown by the reach (m).
     pub extent: [f32; 3],
     /// The body's index, and in the top two bits `PairMeta::moves` (an
-    /// index fits 30 bits: `world::max_bodies` holds worlds below 2^30).
+    /// index fits `BODY_BITS`: `world::max_bodies` holds worlds within it).
     pub body: u32,
 }
 

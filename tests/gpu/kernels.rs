@@ -5,7 +5,7 @@
 use crate::common::world;
 use crate::common::Rng;
 use glam::{Quat, Vec3};
-use verlet::gpu::types::{CellBound, PairMeta, SCAN_SPAN};
+use verlet::gpu::types::{CellBound, PairMeta, MOVES_SHIFT, SCAN_SPAN};
 use verlet::scenes::{box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
 use verlet::world::plan_grid;
@@ -105,7 +105,7 @@ fn grid_sort_matches_a_counting_sort(n: usize) {
         let mut want: Vec<u32> = states[i].pos.iter().map(|v| v.to_bits()).collect();
         want.push(word(i, std::mem::offset_of!(PairMeta, bound)));
         want.extend((0..3).map(|c| word(i, std::mem::offset_of!(PairMeta, extent) + 4 * c)));
-        want.push(i as u32 | word(i, std::mem::offset_of!(PairMeta, moves)) << 30);
+        want.push(i as u32 | word(i, std::mem::offset_of!(PairMeta, moves)) << MOVES_SHIFT);
         assert_eq!(&bounds[record * k..record * (k + 1)], &want[..], "cell_bounds[{k}] (body {i})");
     }
 }

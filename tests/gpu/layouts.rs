@@ -122,6 +122,8 @@ fn constants_match() {
         ("SCAN_RUN", SCAN_RUN),
         ("SCAN_SPAN", SCAN_SPAN),
         ("WOKEN_NOW", WOKEN_NOW),
+        ("BODY_BITS", BODY_BITS),
+        ("MOVES_SHIFT", MOVES_SHIFT),
         ("MAX_POINTS", MAX_POINTS),
         ("NONE", NONE),
         ("GROUND", GROUND),
