@@ -2,6 +2,10 @@
 // eq. 7 for rotation, time-corrected for a changing dt (eq. 11) and damped
 // (eq. 12). Reads state_in, writes each body's own slot of state_out (the
 // predicted pose, with the current pose as its previous one) and of vel0.
+// In a step's second substep and later, it first applies what the last
+// substep's restitution_contacts asked of the body (restitution.wgsl),
+// which a pass of its own did before: a dispatch fewer and a read and write
+// of every state fewer a substep, the same bits.
 //
 // Numerical faults: first, every body's state as read here is checked, every
 // substep, with no readback. A body whose pose is not finite (an infinity or
@@ -147,8 +151,11 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    let s = state_in[i];
     let p = props[i];
+    // the last substep's restitution first (restitution.wgsl's body half,
+    // `restituted`; none before a step's first substep, which follows the
+    // pass "restitution")
+    let s = restituted(i, state_in[i], p, params.substep != 0u);
     let dt = params.dt;
     let wake = params.substep == 0u && (s.pos_low & WAKES) != 0u;
     let wakes = wakes_next(i, s);

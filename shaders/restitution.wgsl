@@ -1,5 +1,5 @@
-// Passes "restitution_contacts" and "restitution", once per substep after
-// the solve: collisions change velocity by rewriting the previous pose (the paper, section III;
+// Passes "restitution_contacts", once per substep after the solve, and
+// "restitution", once per step after the last substep's: collisions change velocity by rewriting the previous pose (the paper, section III;
 // here the displacement from it and the previous rotation). A contact
 // that was approaching faster than a resting contact can (2 |g| dt), and
 // faster than RESTITUTION_THRESHOLD, leaves with -e times its approach speed
@@ -12,9 +12,10 @@
 // Every contact is measured on the velocities after the solve, once per
 // manifold (restitution_contacts, which writes what it asks of each body to
 // its two EndSnaps in snaps and empties its points' friction budgets); each body sums
-// what its manifolds ask (restitution), the turns split among the contacts
-// that acted as in the solve, the bounces combined by direction (see
-// restitution).
+// what its manifolds ask (`restituted`), the turns split among the contacts
+// that acted as in the solve, the bounces combined by direction: in the
+// pass "restitution" after the step's last substep, and in the next
+// substep's integrate after the others.
 
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
@@ -166,20 +167,17 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     set_snap(contact_ref(k, true), end_snap(eb, j, moment_b, acting, flags));
 }
 
-@compute @workgroup_size(WORKGROUP)
-fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = listed_body(gid.x);
-    if (i >= params.body_count) {
-        return;
-    }
-    var s = state_in[i];
-    let p = props[i];
+// The body half: body i's state s with what its manifolds ask applied
+// (restitution_contacts' snaps, summed in pair order), or s itself for a
+// body that is fixed, asleep or touches nothing, or where nothing is
+// `pending`. The pass `restitution` applies it after the step's last
+// substep; integrate applies it, pending, before every later substep, one
+// pass fewer a substep (see integrate.wgsl). `pending` enters by a select,
+// not a branch (see integrate).
+fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState {
+    var s = s_in;
     let first = pair_meta[i].list_start;
-    let end = first + pair_meta[i].contacts;
-    if (is_fixed(p) || first == end || asleep(s)) {
-        state_out[i] = s;
-        return;
-    }
+    let end = select(first, first + pair_meta[i].contacts, pending && !is_fixed(p) && !asleep(s));
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
@@ -213,5 +211,14 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
         s.disp = v * params.dt;
         s.prev_rot = normalize(quat_mul(quat_from_rotvec(-w * params.dt), s.rot));
     }
-    state_out[i] = s;
+    return s;
+}
+
+@compute @workgroup_size(WORKGROUP)
+fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = listed_body(gid.x);
+    if (i >= params.body_count) {
+        return;
+    }
+    state_out[i] = restituted(i, state_in[i], props[i], true);
 }

@@ -938,7 +938,11 @@ impl World {
                     plan.push((Stage::SolveJoints, sub));
                 }
             }
-            plan.extend([(Stage::RestitutionContacts, sub), (Stage::Restitution, sub)]);
+            plan.push((Stage::RestitutionContacts, sub));
+            // the next substep's integrate applies what it asks (integrate.wgsl)
+            if sub + 1 == self.settings.substeps as usize {
+                plan.push((Stage::Restitution, sub));
+            }
         }
         plan
     }

@@ -74,7 +74,7 @@ pub fn wgsl_f32(name: &str, value: f32) -> String {
 pub const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
 pub const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
 pub const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE];
-pub const INTEGRATE_PASS: &[&str] = &[COMMON, BINDINGS, INTEGRATE];
+pub const INTEGRATE_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION, INTEGRATE];
 pub const SOLVE_PASS: &[&str] = &[COMMON, BINDINGS, SOLVE];
 pub const RESTITUTION_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION];
 

@@ -6,13 +6,16 @@
 //!    bodies' contact lists (shaders/narrowphase.wgsl, collide.wgsl; boxes: the separating
 //!    axis); `contact_lists` sorts each body's list into pair order; `narrowphase_clip`
 //!    clips the face contacts, over the top run of the pool
-//! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl)
+//! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl), after
+//!    applying the last substep's restitution in a step's later substeps
 //! 5. `solve_contacts`, `solve`, `solve_joints` — `iterations` sweeps of corrective snaps:
 //!    per manifold what it asks of its bodies, then per body the sum (Jacobi), then per
 //!    joint island its joints in turn (Gauss-Seidel; only in scenes with joints)
 //!    (shaders/solve.wgsl)
 //! 6. `restitution_contacts`, `restitution` — bounce and dynamic friction, by
-//!    rewriting the previous pose, in the same two halves (shaders/restitution.wgsl)
+//!    rewriting the previous pose, in the same two halves (shaders/restitution.wgsl);
+//!    the body half as a pass only after the last substep (the next `integrate`
+//!    applies it after the others)
 //!
 //! Passes 1-3 only read the state; `integrate`, `solve` and `restitution`
 //! read one state buffer and write the other, so the current state flips
@@ -252,7 +255,7 @@ impl Stage {
             }
             Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta, Points],
-            Stage::Integrate => &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta],
+            Stage::Integrate => &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta, Snaps, BodyPairs, Snaps1],
             Stage::SolveContacts => {
                 &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3]
             }
