@@ -1,6 +1,7 @@
 // Passes "restitution_contacts", once per substep after the solve, and
-// "restitution", once per step after the last substep's: collisions change velocity by rewriting the previous pose (the paper, section III;
-// here the displacement from it and the previous rotation). A contact
+// "restitution", once per step after the last substep's: collisions change
+// velocity by rewriting the previous pose (the paper, section III; here
+// the displacement from it and the previous rotation). A contact
 // that was approaching faster than a resting contact can (2 |g| dt), and
 // faster than RESTITUTION_THRESHOLD, leaves with -e times its approach speed
 // along the normal; slower ones stay at rest, so resting bodies do not hop.
@@ -177,7 +178,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
 fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState {
     var s = s_in;
     let first = pair_meta[i].list_start;
-    let end = select(first, first + pair_meta[i].contacts, pending && !is_fixed(p) && !asleep(s));
+    let acts = !is_fixed(p) && !asleep(s);
+    let end = select(first, first + pair_meta[i].contacts, acts && pending);
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
