@@ -6,7 +6,7 @@ use crate::common::world;
 use crate::common::Rng;
 use glam::{Quat, Vec3};
 use verlet::gpu::types::{CellBound, PairMeta, MOVES_SHIFT, SCAN_SPAN};
-use verlet::scenes::{box_body, sphere_body};
+use verlet::scenes::{self, box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
 use verlet::world::plan_grid;
 use verlet::{Scene, Settings};
@@ -95,19 +95,58 @@ fn grid_sort_matches_a_counting_sort(n: usize) {
         starts[h + 1] += starts[h];
     }
     assert_eq!(cell_start[..starts.len()], starts[..], "cell_start");
-    // cell_bounds: each grid body's centre, bounds, index and moves at its
-    // place in sorted, copied bit for bit from state_in and pair_meta
+    let moves = assert_cell_bounds(&w, n);
+    assert!(moves.contains(&STAYS_FIXED) && moves.contains(&MOVES), "{moves:?}");
+}
+
+// PairMeta::moves (common.wgsl)
+const STAYS_FIXED: u32 = 0;
+const MOVES: u32 = 1;
+const SLEEPS: u32 = 2;
+
+/// cell_bounds holds each of the `n` grid bodies' centre, bounds, index and
+/// moves at its place in sorted, copied bit for bit from state_in and
+/// pair_meta (after the grid stages); returns the moves it found.
+fn assert_cell_bounds(w: &verlet::World, n: usize) -> Vec<u32> {
+    let sorted = w.read_words(Buffer::Sorted).unwrap();
+    let states = w.read_raw().unwrap();
+    let meta = w.read_words(Buffer::PairMeta).unwrap();
     let bounds = w.read_words(Buffer::CellBounds).unwrap();
-    let record = std::mem::size_of::<CellBound>() / 4;
+    let (stride, record) = (std::mem::size_of::<PairMeta>() / 4, std::mem::size_of::<CellBound>() / 4);
     let word = |i: usize, field: usize| meta[stride * i + field / 4];
+    let mut seen = Vec::new();
     for (k, &i) in sorted[..n].iter().enumerate() {
         let i = i as usize;
+        let moves = word(i, std::mem::offset_of!(PairMeta, moves));
         let mut want: Vec<u32> = states[i].pos.iter().map(|v| v.to_bits()).collect();
         want.push(word(i, std::mem::offset_of!(PairMeta, bound)));
         want.extend((0..3).map(|c| word(i, std::mem::offset_of!(PairMeta, extent) + 4 * c)));
-        want.push(i as u32 | word(i, std::mem::offset_of!(PairMeta, moves)) << MOVES_SHIFT);
+        want.push(i as u32 | moves << MOVES_SHIFT);
         assert_eq!(&bounds[record * k..record * (k + 1)], &want[..], "cell_bounds[{k}] (body {i})");
+        if !seen.contains(&moves) {
+            seen.push(moves);
+        }
     }
+    seen
+}
+
+/// A sleeper's moves (SLEEPS, the top bit of CellBound::body) beside its
+/// index: a pile of 200 cubes run until some of it sleeps, then the grid
+/// stages alone.
+#[test]
+fn cell_bounds_hold_a_sleepers_moves() {
+    let scene = scenes::pile(200, 3);
+    let n = scene.bodies.len();
+    let Some(mut w) = world(&scene) else { return };
+    let mut steps = 0;
+    while w.read_state().unwrap().iter().filter(|b| b.asleep).count() < n / 4 {
+        w.step(30).unwrap();
+        steps += 30;
+        assert!(steps <= 1200, "a quarter of the pile did not fall asleep");
+    }
+    w.run_stages(&grid_stages()).unwrap();
+    let moves = assert_cell_bounds(&w, n);
+    assert!(moves.contains(&SLEEPS) && moves.contains(&MOVES), "{moves:?}");
 }
 
 /// integrate carries a free body's displacement and adds g h^2 (eq. 6 with
