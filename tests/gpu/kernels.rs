@@ -2,8 +2,8 @@
 //! (`World::run_stages`) and checks what one kernel wrote against what it
 //! must write, so a regression names its pass.
 
-use crate::common::world;
 use crate::common::Rng;
+use crate::common::{step_until_asleep, world};
 use glam::{Quat, Vec3};
 use verlet::gpu::types::{CellBound, PairMeta, MOVES_SHIFT, SCAN_SPAN};
 use verlet::scenes::{self, box_body, sphere_body};
@@ -138,12 +138,7 @@ fn cell_bounds_hold_a_sleepers_moves() {
     let scene = scenes::pile(200, 3);
     let n = scene.bodies.len();
     let Some(mut w) = world(&scene) else { return };
-    let mut steps = 0;
-    while w.read_state().unwrap().iter().filter(|b| b.asleep).count() < n / 4 {
-        w.step(30).unwrap();
-        steps += 30;
-        assert!(steps <= 1200, "a quarter of the pile did not fall asleep");
-    }
+    step_until_asleep(&mut w, n / 4, 1200);
     w.run_stages(&grid_stages()).unwrap();
     let moves = assert_cell_bounds(&w, n);
     assert!(moves.contains(&SLEEPS) && moves.contains(&MOVES), "{moves:?}");

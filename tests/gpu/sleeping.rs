@@ -5,7 +5,7 @@
 //! Bodies on joints sleep and wake with their whole joint island; free-flying
 //! bodies and islands never sleep.
 
-use crate::common::{v3, world};
+use crate::common::{step_until_asleep, v3, world};
 use verlet::scene::{Joint, WORLD};
 use verlet::scenes::{self, box_body, sphere_body};
 use verlet::step::Buffer;
@@ -372,12 +372,7 @@ fn the_body_passes_run_over_the_awake_bodies_and_leave_sleepers_alike_in_both_bu
     let scene = scenes::pile(200, 3);
     let n = scene.bodies.len();
     let Some(mut w) = world(&scene) else { return };
-    let mut steps = 0;
-    while w.read_state().unwrap().iter().filter(|b| b.asleep).count() < n / 2 {
-        w.step(30).unwrap();
-        steps += 30;
-        assert!(steps <= 1200, "the pile did not half fall asleep");
-    }
+    let steps = step_until_asleep(&mut w, n / 2, 1200);
     let listed = |w: &verlet::World| {
         let count = w.read_words(Buffer::Status).unwrap()[16] as usize;
         w.read_words(Buffer::Sorted).unwrap()[n..n + count].to_vec()

@@ -34,6 +34,18 @@ pub fn world(scene: &Scene) -> Option<World> {
     Some(World::with_gpu(gpu, scene).expect("scene uploads"))
 }
 
+/// Steps `w` 30 at a time until at least `asleep` of its bodies sleep,
+/// failing past `max_steps`; returns the steps taken.
+pub fn step_until_asleep(w: &mut World, asleep: usize, max_steps: u64) -> u64 {
+    let mut steps = 0;
+    while w.read_state().unwrap().iter().filter(|b| b.asleep).count() < asleep {
+        w.step(30).unwrap();
+        steps += 30;
+        assert!(steps <= max_steps, "fewer than {asleep} bodies asleep after {steps} steps");
+    }
+    steps
+}
+
 pub fn v3(a: [f32; 3]) -> glam::Vec3 {
     glam::Vec3::from_array(a)
 }
