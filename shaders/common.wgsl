@@ -170,7 +170,9 @@ const SUPPORT_ONE: f32 = 32767.0;
 // STAYS_FIXED), how many of its
 // pairs have a manifold (contact_lists: its list then starts with their
 // contact references, see `contact_ref`), and its bounds: the half extents
-// of its world box grown by its reach (how far it may move this step, m),
+// of its world box grown by its reach (how far any point of it may move
+// this step, m: the centre's move and `spin`, what its turn adds; see
+// grid.wgsl's reach_of and spin_reach_of),
 // how many of its manifolds are with an end that stays and what its normal
 // pushes against them count its inverse mass (contact_lists; the splits,
 // see bindings.wgsl's friction_split and solve.wgsl's stay_splits). The
@@ -189,6 +191,7 @@ struct PairMeta {
     held: u32,
     normal_split: f32,
     reach: f32,
+    spin: f32,
 }
 
 // A grid body's bounds in the grid's order, as the pair walks read them

@@ -51,6 +51,19 @@ fn reach_of(i: u32) -> f32 {
     return length(s.disp) * ratio + length(params.gravity) * h * h;
 }
 
+// How far body i's turn moves any of its points in the coming step (m), if
+// it keeps the last substep's turn: a unit quaternion's change of d moves a
+// point at r from the centre by at most 2 d r, so at most 2 d R for the
+// bounding radius R, a substep; rescaled as reach_of. (q and -q are one
+// rotation: d is the nearer of the two.) A sphere turns into itself: 0.
+fn spin_reach_of(i: u32) -> f32 {
+    let s = state_in[i];
+    let p = props[i];
+    let ratio = params.dt / params.dt_prev * f32(params.substeps);
+    let turned = min(length(s.rot - s.prev_rot), length(s.rot + s.prev_rot));
+    return select(2.0 * turned * p.half_extents.w * ratio, 0.0, p.shape == SHAPE_SPHERE);
+}
+
 // Half extents of body i's world box: |R| h for a box, the radius for a sphere.
 fn world_extent(i: u32) -> vec3<f32> {
     let p = props[i];
@@ -85,13 +98,16 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     sorted[params.body_count + i] = NONE; // no body listed here yet
     let reach = reach_of(i);
+    let spin = spin_reach_of(i);
     let fixed = is_fixed(props[i]);
     let moves = !fixed && (!asleep(state_in[i]) || (state_in[i].pos_low & WAKES) != 0u);
     let sleeps = !fixed && !moves;
     pair_meta[i].moves = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
-    pair_meta[i].reach = reach;
-    pair_meta[i].extent = world_extent(i) + vec3<f32>(reach);
+    pair_meta[i].reach = reach + spin;
+    pair_meta[i].spin = spin;
+    pair_meta[i].extent = world_extent(i) + vec3<f32>(reach + spin);
+    // the bounding sphere turns into itself: only the centre's move grows it
     pair_meta[i].bound = props[i].half_extents.w + reach;
     if (!in_grid(i)) {
         return;

@@ -16,7 +16,7 @@ pub const RESTITUTION: &str = include_str!("../../shaders/restitution.wgsl");
 /// step's passes, the input kernels, the renderer).
 pub fn shared_constants() -> String {
     use crate::gpu::types::*;
-    use crate::world::{FaultKind, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
+    use crate::world::{FaultKind, CONTACT_MARGIN, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
     let mut out = String::from("// Shared with Rust: written by src/gpu/shaders.rs from the Rust constants.\n");
     let words = [
         ("NONE", NONE),
@@ -53,6 +53,7 @@ pub fn shared_constants() -> String {
         ("MAX_SPIN", MAX_SPIN),
         ("MAX_TURN", MAX_TURN),
         ("MAX_DEPENETRATION_SPEED", MAX_DEPENETRATION_SPEED),
+        ("CONTACT_MARGIN", CONTACT_MARGIN),
     ] {
         out += &wgsl_f32(name, value);
     }

@@ -227,9 +227,11 @@ pub struct PairMeta {
     /// How many times its normal pushes against ends that stay count its
     /// inverse mass (contact_lists; shaders/solve.wgsl's stay_splits).
     pub normal_split: f32,
-    /// How far it may move this step (m).
+    /// How far any point of it may move this step (m): its centre's move and
+    /// `spin`.
     pub reach: f32,
-    pub _pad: u32,
+    /// How far its turn may move any point of it this step (m).
+    pub spin: f32,
 }
 
 /// One contact point as one body of its pair sees it (host only, from

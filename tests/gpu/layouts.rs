@@ -87,7 +87,8 @@ fn shared_structs_match_member_by_member() {
             bound,
             held,
             normal_split,
-            reach
+            reach,
+            spin
         }
     );
 }
@@ -110,7 +111,7 @@ fn constants_match() {
         naga::Expression::Literal(naga::Literal::F32(v)) => v,
         e => panic!("{name}: unexpected {e:?}"),
     };
-    use verlet::world::{FaultKind, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
+    use verlet::world::{FaultKind, CONTACT_MARGIN, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
     for (name, value) in [
         ("SHAPE_BOX", SHAPE_BOX),
         ("SHAPE_SPHERE", SHAPE_SPHERE),
@@ -138,8 +139,13 @@ fn constants_match() {
     ] {
         assert_eq!(word(name), value, "{name}");
     }
-    for (name, value) in [("MAX_SPEED", MAX_SPEED), ("MAX_DISTANCE", MAX_DISTANCE), ("MAX_SPIN", MAX_SPIN), ("MAX_TURN", MAX_TURN)]
-    {
+    for (name, value) in [
+        ("MAX_SPEED", MAX_SPEED),
+        ("MAX_DISTANCE", MAX_DISTANCE),
+        ("MAX_SPIN", MAX_SPIN),
+        ("MAX_TURN", MAX_TURN),
+        ("CONTACT_MARGIN", CONTACT_MARGIN),
+    ] {
         assert_eq!(float(name).to_bits(), value.to_bits(), "{name}");
     }
     // an awkward value survives the round trip exactly

@@ -7,7 +7,7 @@ use crate::common::Rng;
 use glam::{Quat, Vec3};
 use verlet::reference::collide::{collide, Placed, ShapeKind};
 use verlet::scenes::{box_body, sphere_body};
-use verlet::world::initial_state;
+use verlet::world::{initial_state, CONTACT_MARGIN};
 use verlet::{Body, Scene, Settings, Shape};
 
 fn random_body(rng: &mut Rng, k: usize, at: Vec3) -> Body {
@@ -55,7 +55,7 @@ fn gpu_manifolds_match_the_cpu_reference() {
         let (i, j) = (2 * k, 2 * k + 1);
         let (pa, pb) = (placed(&scene.bodies[i], &settings), placed(&scene.bodies[j], &settings));
         // at rest, no gravity: the speculative margin is the fixed contact margin
-        let cpu = collide(&pa, &pb, 0.02);
+        let cpu = collide(&pa, &pb, CONTACT_MARGIN);
         let gpu = &contacts[i];
         assert!(gpu.iter().all(|c| c.partner == j as u32), "pair {k}: contact with a body of another pair");
         assert_eq!(contacts[j].len(), gpu.len(), "pair {k}: the two bodies hold different counts");

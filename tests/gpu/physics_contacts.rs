@@ -287,8 +287,9 @@ fn a_fast_rolling_ball_stays_on_what_it_rolls_on() {
 /// not how fast each moves (pair_margin in shaders/pairs.wgsl): two boxes
 /// falling side by side 10 cm apart at 5 m/s get no contact (the sum of
 /// their reaches, about 17 cm, made them one), while a box falling at 5 m/s
-/// towards a fixed one 10 cm below gets its contact before they touch and
-/// lands without sinking in.
+/// towards a fixed one 9 cm below gets its contact before they touch (it
+/// comes 8.6 cm nearer in a step, and CONTACT_MARGIN is 1 cm) and lands
+/// without sinking in.
 #[test]
 fn bodies_falling_together_get_no_contact_and_one_falling_onto_another_does() {
     let mut scene = scenes::stack(0);
@@ -298,7 +299,7 @@ fn bodies_falling_together_get_no_contact_and_one_falling_onto_another_does() {
     right.linear_velocity = [0.0, -5.0, 0.0];
     let mut floor = box_body([0.5; 3], [5.0, 20.0, 0.0]);
     floor.fixed = true;
-    let mut faller = box_body([0.5; 3], [5.0, 21.1, 0.0]);
+    let mut faller = box_body([0.5; 3], [5.0, 21.09, 0.0]);
     faller.linear_velocity = [0.0, -5.0, 0.0];
     scene.bodies = vec![left, right, floor, faller];
     let Some(mut w) = world(&scene) else { return };
@@ -309,7 +310,7 @@ fn bodies_falling_together_get_no_contact_and_one_falling_onto_another_does() {
     eprintln!("side by side: {} and {} contact points, {gap} m apart", contacts[0].len(), contacts[1].len());
     assert!(contacts[0].is_empty() && contacts[1].is_empty(), "bodies falling together got contacts");
     assert!((gap - 0.1).abs() < 1e-4, "the pair's gap changed to {gap} m");
-    eprintln!("falling onto a fixed box 10 cm below: {} contact points", contacts[3].len());
+    eprintln!("falling onto a fixed box 9 cm below: {} contact points", contacts[3].len());
     assert_eq!(contacts[3].len(), 4, "the falling box has no speculative contact with the one below it");
     let mut deepest = 0.0f32;
     for _ in 0..30 {
@@ -336,6 +337,46 @@ fn a_fast_box_does_not_pass_through_a_wall() {
     }
     eprintln!("bullet box: farthest x {farthest} (wall face at 4.9)");
     assert!(farthest < 4.9 - 0.25 + 0.05, "the box reached x = {farthest}: through the wall");
+}
+
+/// A box spinning fast as it drifts into a wall gets its contacts before a
+/// corner comes round into the wall: the speculative margin counts how far
+/// a body's turn may move its points within the step (PairMeta's spin in
+/// shaders/common.wgsl). A unit cube turning at 8 rad/s brings its side
+/// nearer a wall it faces by up to 6 cm a step. Measured, the deepest a
+/// corner came into the wall: 0.6 mm (8 rad/s, 1 m/s) and 2.3 mm (12 rad/s,
+/// 0.5 m/s); with a fixed margin of 2 cm and no spin term, 17 and 11 mm.
+#[test]
+fn a_spinning_box_meets_a_wall_without_a_corner_sinking_in() {
+    let mut scene = scenes::stack(0);
+    scene.settings.gravity = [0.0; 3];
+    scene.ground = None;
+    let mut wall = box_body([0.5, 3.0, 3.0], [2.5, 0.0, 0.0]); // its face at x = 2
+    wall.fixed = true;
+    // spin (rad/s) about z, where the box starts along x, its drift (m/s)
+    for (spin, x0, drift) in [(8.0f32, 0.6f32, 1.0f32), (12.0, 0.2, 0.5)] {
+        let mut spinner = box_body([0.5; 3], [x0, 0.0, 0.0]);
+        spinner.linear_velocity = [drift, 0.0, 0.0];
+        spinner.angular_velocity = [0.0, 0.0, spin];
+        scene.bodies = vec![wall.clone(), spinner];
+        let Some(mut w) = world(&scene) else { return };
+        let mut deepest = 0.0f32;
+        for _ in 0..150 {
+            w.step(1).unwrap();
+            let s = w.read_state().unwrap()[1];
+            let corners = (0..8).map(|k| {
+                let c = Vec3::new(
+                    if k & 1 == 0 { -0.5 } else { 0.5 },
+                    if k & 2 == 0 { -0.5 } else { 0.5 },
+                    if k & 4 == 0 { -0.5 } else { 0.5 },
+                );
+                (v3(s.position) + quat(s.orientation) * c).x
+            });
+            deepest = deepest.max(corners.fold(f32::MIN, f32::max) - 2.0);
+        }
+        eprintln!("box spinning at {spin} rad/s into a wall at {drift} m/s: a corner came {deepest} m into it at most");
+        assert!(deepest < 0.005, "a corner of the box spinning at {spin} rad/s came {deepest} m into the wall");
+    }
 }
 
 fn ramp_slide(mu: f32) -> f32 {
