@@ -186,6 +186,7 @@ pub const MAX_SPIN: f32 = 1e4;
 /// joints close an old gap no faster (`MAX_DEPENETRATION_SPEED` in the
 /// shaders).
 pub const MAX_DEPENETRATION_SPEED: f32 = 3.0;
+pub const MAX_TURN: f32 = 3.0;
 /// The gap (m) within which two bodies get contacts whatever their speed
 /// (`CONTACT_MARGIN` in the shaders): it covers what the step's own snaps
 /// bring them nearer by, since contacts are found once a step. What their
@@ -193,7 +194,6 @@ pub const MAX_DEPENETRATION_SPEED: f32 = 3.0;
 /// (pairs.wgsl's `pair_margin`: their relative displacement, gravity, and
 /// how far each one's turn moves its points).
 pub const CONTACT_MARGIN: f32 = 0.01;
-pub const MAX_TURN: f32 = 3.0;
 
 /// What was wrong with a faulted body (the low three bits of `status[2]`,
 /// `FAULT_*` in integrate.wgsl).

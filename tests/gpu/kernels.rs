@@ -147,6 +147,71 @@ fn cell_bounds_hold_a_sleepers_moves() {
 /// integrate carries a free body's displacement and adds g h^2 (eq. 6 with
 /// a steady step), and repeats its last rotation (eq. 7): bit for bit what
 /// the same f32 sums give on the CPU.
+/// grid_count bounds each body by how far it may move in the coming step
+/// (grid.wgsl's reach_of and spin_reach_of): its centre by its last
+/// displacement, rescaled to the step, plus gravity's part; its points by
+/// that plus its turn's part, 2 |q - q_prev| R a substep (the nearer of q
+/// and -q), none for a sphere. PairMeta's reach, spin, bound (the bounding
+/// radius grown by the centre's move alone) and extent (the world box grown
+/// by all of it), against the same sums on the CPU.
+#[test]
+fn grid_count_bounds_each_body_by_its_move_and_turn() {
+    let mut bodies = Vec::new();
+    for (k, spin) in [0.0f32, 4.0, 30.0].into_iter().enumerate() {
+        let mut b = box_body([0.5, 0.25, 0.4], [3.0 * k as f32, 5.0, 0.0]);
+        b.linear_velocity = [1.5, -2.0 * k as f32, 0.5];
+        b.angular_velocity = [0.3 * spin, -spin, 0.5 * spin];
+        b.orientation = Quat::from_rotation_y(0.4 + k as f32).to_array();
+        bodies.push(b);
+    }
+    let mut ball = sphere_body(0.3, [0.0, 5.0, 3.0]);
+    ball.angular_velocity = [0.0, 0.0, 20.0];
+    ball.linear_velocity = [0.0, -3.0, 0.0];
+    bodies.push(ball);
+    let scene = Scene { settings: Settings::default(), ground: None, bodies, joints: vec![], camera: None };
+    let Some(mut w) = world(&scene) else { return };
+    w.run_stages(&[Stage::GridCount]).unwrap();
+    let states = w.read_raw().unwrap();
+    let meta: Vec<PairMeta> =
+        bytemuck::pod_collect_to_vec(&bytemuck::cast_slice::<u32, u8>(&w.read_words(Buffer::PairMeta).unwrap()));
+    let settings = scene.settings;
+    // run_stages runs a step's first substep after one of the same length
+    let steps = settings.substeps as f32;
+    let h = settings.dt;
+    for (i, body) in scene.bodies.iter().enumerate() {
+        let s = &states[i];
+        let (q, prev) = (glam::Vec4::from(s.rot), glam::Vec4::from(s.prev_rot));
+        let radius = body.bounding_radius();
+        let reach = Vec3::from(s.disp).length() * steps + Vec3::from(settings.gravity).length() * h * h;
+        let turned = (q - prev).length().min((q + prev).length());
+        let spin = match body.shape {
+            verlet::Shape::Sphere { .. } => 0.0,
+            verlet::Shape::Box { .. } => 2.0 * turned * radius * steps,
+        };
+        let world_box = match body.shape {
+            verlet::Shape::Sphere { radius } => Vec3::splat(radius),
+            verlet::Shape::Box { half_extents } => {
+                let r = glam::Mat3::from_quat(Quat::from_array(s.rot));
+                let h = Vec3::from(half_extents);
+                r.x_axis.abs() * h.x + r.y_axis.abs() * h.y + r.z_axis.abs() * h.z
+            }
+        };
+        let m = &meta[i];
+        let close = |got: f32, want: f32| (got - want).abs() <= 1e-5 * want.abs().max(1.0);
+        assert!(close(m.spin, spin), "body {i}: spin {} against {spin}", m.spin);
+        assert!(close(m.reach, reach + spin), "body {i}: reach {} against {}", m.reach, reach + spin);
+        assert!(close(m.bound, radius + reach), "body {i}: bound {} against {}", m.bound, radius + reach);
+        for c in 0..3 {
+            let want = world_box[c] + reach + spin;
+            assert!(close(m.extent[c], want), "body {i}: extent[{c}] {} against {want}", m.extent[c]);
+        }
+        if i == 2 {
+            // 30 rad/s turns a point of this box 0.22 m a step
+            assert!(spin > 0.2, "the fast spinner's spin reach {spin}");
+        }
+    }
+}
+
 #[test]
 fn integrate_carries_the_displacement_and_adds_gravity() {
     let mut body = box_body([0.5, 0.25, 0.4], [3.0, 12.0, -2.0]);
