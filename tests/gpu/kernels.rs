@@ -172,8 +172,7 @@ fn grid_count_bounds_each_body_by_its_move_and_turn() {
     let Some(mut w) = world(&scene) else { return };
     w.run_stages(&[Stage::GridCount]).unwrap();
     let states = w.read_raw().unwrap();
-    let meta: Vec<PairMeta> =
-        bytemuck::pod_collect_to_vec(&bytemuck::cast_slice::<u32, u8>(&w.read_words(Buffer::PairMeta).unwrap()));
+    let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
     let settings = scene.settings;
     // run_stages runs a step's first substep after one of the same length
     let steps = settings.substeps as f32;
