@@ -34,18 +34,21 @@ fn worst_overlap(scene: &Scene, state: &[BodyOutput]) -> f32 {
     worst
 }
 
+/// The eight corners of a box of half extents `h` at pose `s` (world).
+fn corners(h: [f32; 3], s: &BodyOutput) -> impl Iterator<Item = Vec3> + '_ {
+    (0..8).map(move |k| {
+        let c = Vec3::new(
+            if k & 1 == 0 { -h[0] } else { h[0] },
+            if k & 2 == 0 { -h[1] } else { h[1] },
+            if k & 4 == 0 { -h[2] } else { h[2] },
+        );
+        v3(s.position) + quat(s.orientation) * c
+    })
+}
+
 fn lowest_corner(scene: &Scene, i: usize, s: &BodyOutput) -> f32 {
     match scene.bodies[i].shape {
-        Shape::Box { half_extents: h } => (0..8)
-            .map(|k| {
-                let c = Vec3::new(
-                    if k & 1 == 0 { -h[0] } else { h[0] },
-                    if k & 2 == 0 { -h[1] } else { h[1] },
-                    if k & 4 == 0 { -h[2] } else { h[2] },
-                );
-                (v3(s.position) + quat(s.orientation) * c).y
-            })
-            .fold(f32::MAX, f32::min),
+        Shape::Box { half_extents: h } => corners(h, s).map(|c| c.y).fold(f32::MAX, f32::min),
         Shape::Sphere { radius } => s.position[1] - radius,
     }
 }
@@ -364,15 +367,8 @@ fn a_spinning_box_meets_a_wall_without_a_corner_sinking_in() {
         for _ in 0..150 {
             w.step(1).unwrap();
             let s = w.read_state().unwrap()[1];
-            let corners = (0..8).map(|k| {
-                let c = Vec3::new(
-                    if k & 1 == 0 { -0.5 } else { 0.5 },
-                    if k & 2 == 0 { -0.5 } else { 0.5 },
-                    if k & 4 == 0 { -0.5 } else { 0.5 },
-                );
-                (v3(s.position) + quat(s.orientation) * c).x
-            });
-            deepest = deepest.max(corners.fold(f32::MIN, f32::max) - 2.0);
+            let farthest = corners([0.5; 3], &s).map(|c| c.x).fold(f32::MIN, f32::max);
+            deepest = deepest.max(farthest - 2.0);
         }
         eprintln!("box spinning at {spin} rad/s into a wall at {drift} m/s: a corner came {deepest} m into it at most");
         assert!(deepest < 0.005, "a corner of the box spinning at {spin} rad/s came {deepest} m into the wall");
