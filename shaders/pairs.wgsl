@@ -33,7 +33,9 @@
 // sleepers). A grid body owns its pairs with every large body (it always
 // walks them all); a large body (kept out of the grid) owns only its pairs
 // with large bodies of higher index, so it never walks the cells; every
-// body owns its pair with the ground. A pair is wanted when the two
+// body owns its pair with the ground. A fast body (`is_fast`) walks every
+// cell within its reach instead, and owns its pairs with all it finds there
+// but the faster bodies (`outranks`); no other walk takes a pair with it. A pair is wanted when the two
 // bodies' bounds come within the margin, they are not joined, and one of
 // them moves: not fixed and awake, or asleep but woken by the last step's
 // narrowphase (pair_meta's MOVES). Only the owner decides, alike in both
@@ -107,14 +109,35 @@ fn wants_ground(i: u32) -> bool {
         && state_in[i].pos.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
 }
 
-// The walking body, read once: its index, centre, bounds, whether it moves
-// and where its joint ends lie in joint_refs (start, end).
+// Whether the walker owns its pair with body j (box size `size_j`) when one
+// of them is fast: the larger box owns it (a fast body's walk covers any
+// partner with a box no larger than its own), then the lower index.
+fn outranks(j: u32, size_j: f32) -> bool {
+    return walker.size > size_j || (walker.size == size_j && walker.index < j);
+}
+
+// How many cells out a fast walker looks along each axis: its pairs are
+// with boxes no larger than its own, so within twice its size and the
+// margin of its centre.
+fn rings_of(size: f32) -> u32 {
+    return u32(ceil(clamp((2.0 * size + CONTACT_MARGIN) / params.cell_size * 1.001, 1.0, MAX_RINGS)));
+}
+
+// Beyond this many rings a fast walker visits every bucket (the grid has
+// fewer than (2 MAX_RINGS + 1)^3).
+const MAX_RINGS: f32 = 500.0;
+
+// The walking body, read once: its index, centre, bounds (and the box's
+// size), whether it moves, whether it is fast and where its joint ends lie
+// in joint_refs (start, end).
 struct Walker {
     index: u32,
     pos: vec3<f32>,
     extent: vec3<f32>,
     bound: f32,
+    size: f32,
     moves: bool,
+    fast: bool,
     joints: vec2<u32>,
 }
 
@@ -161,18 +184,19 @@ fn take(j: u32) {
     owned = owned + 1u;
 }
 
-// Every body whose own cell is c (a bucket may also hold other cells) that
-// the walk owns a pair with: in the walker's own cell (`above` the
-// walker's index; NONE for another cell) those of higher index and the
-// sleepers, in a cell behind the walker's (`behind`) the sleepers only,
-// in one ahead of it every body; up to the first whose box begins beyond
-// the walker's along x by more than the margin: a bucket is sorted by
-// where its boxes begin (grid_sort), so no later one can be wanted either.
-// (`wanted_bounds` decides, with its own roundings; the stop keeps a
-// slack of 1e-4 m and 1e-5 of the position.) The candidates' bounds come
-// from cell_bounds, by their place in the grid (grid_sort).
-fn visit_cell(c: vec3<i32>, above: u32, behind: bool) {
-    let h = bucket_of(c);
+// Every body of bucket h whose own cell is c (a bucket may also hold
+// other cells; `any_cell`: whatever its cell) that the walk owns a pair
+// with: in the walker's own cell (`above` the walker's index; NONE for
+// another cell) those of higher index and the sleepers, in a cell behind
+// the walker's (`behind`) the sleepers only, in one ahead of it every body,
+// and where the walker or the body is fast, as `outranks` says; up to the
+// first whose box begins beyond the walker's along x by more than the
+// margin: a bucket is sorted by where its boxes begin (grid_sort), so no
+// later one can be wanted either. (`wanted_bounds` decides, with its own
+// roundings; the stop keeps a slack of 1e-4 m and 1e-5 of the position.)
+// The candidates' bounds come from cell_bounds, by their place in the grid
+// (grid_sort).
+fn visit_bucket(h: u32, c: vec3<i32>, any_cell: bool, above: u32, behind: bool) {
     let end = cell_start[h + 1u];
     let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
     for (var k = cell_start[h]; k < end; k = k + 1u) {
@@ -188,48 +212,62 @@ fn visit_cell(c: vec3<i32>, above: u32, behind: bool) {
         if (!takes || behind) {
             takes = moves_j == SLEEPS;
         }
-        if (takes && all(cell_of(cb.pos) == c) && wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j) && !joined_to_walker(j)) {
+        if (walker.fast || (cb.body & FAST_BODY) != 0u) {
+            takes = j != walker.index && outranks(j, box_size(cb.extent));
+        }
+        if (takes && (any_cell || all(cell_of(cb.pos) == c)) && wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j) && !joined_to_walker(j)) {
             take(j);
         }
     }
 }
 
-// The n-th cell a walk visits, as an offset from the walker's own (n = 0):
-// the 13 ahead of it (n = 1..13, cell_ahead), then the same 13 behind it,
-// mirrored (n = 14..26).
-fn walk_cell(n: u32) -> vec3<i32> {
-    let behind = n > 13u;
-    let c = cell_ahead(select(n, n - 13u, behind));
-    return select(c, -c, behind);
-}
-
-// Cell n of the 13 ahead of the walker's own (n = 0 is its own): the 9 at
-// +x (y, then z, from -1 to 1), the 3 at the same x and +y (z from -1 to
-// 1), the one at the same x and y and +z.
-fn cell_ahead(n: u32) -> vec3<i32> {
-    let m = i32(n) - 1;
-    if (n == 0u) {
-        return vec3<i32>(0);
+// The m-th cell ahead of the walker's (m from 1; after `o`, the one
+// before it), as an offset from the walker's, for a walk `rings` cells
+// out: those at +x (x from 1, then y, then z, each from -rings), then
+// those at the same x and +y, then those at the same x and y and +z. One
+// ring out these are the 13 cells ahead (9 + 3 + 1); mirrored, they are
+// the 13 behind. (Stepping from the cell before instead of working the
+// cell out from m: a division by a number not known when the kernel is
+// compiled is eight divisions on lavapipe.)
+fn next_cell(o: vec3<i32>, m: u32, rings: u32) -> vec3<i32> {
+    let r = i32(rings);
+    let side = 2u * rings + 1u;
+    let plus_x = rings * side * side;
+    let plus_y = rings * side;
+    if (m == 1u) {
+        return vec3<i32>(1, -r, -r);
     }
-    if (n <= 9u) {
-        return vec3<i32>(1, m / 3 - 1, m % 3 - 1);
+    if (m == 1u + plus_x) {
+        return vec3<i32>(0, 1, -r);
     }
-    if (n <= 12u) {
-        return vec3<i32>(0, 1, m - 10);
+    if (m == 1u + plus_x + plus_y) {
+        return vec3<i32>(0, 0, 1);
     }
-    return vec3<i32>(0, 0, 1);
+    var c = o + vec3<i32>(0, 0, 1);
+    if (c.z > r) {
+        c = vec3<i32>(c.x, c.y + 1, -r);
+    }
+    if (c.y > r) {
+        c = vec3<i32>(c.x + 1, -r, c.z);
+    }
+    return c;
 }
 
 // The ground, then (for a body in the grid) its own cell and the 13 cells
 // ahead of it, and the 13 behind it for sleepers where any grid body
-// sleeps, then the large bodies it owns pairs with. A sleeper walks no
+// sleeps (a fast body: every cell within its reach), then the large bodies
+// it owns pairs with. A sleeper walks no
 // cells: pairs of sleepers are not wanted, and a body that moves owns its
 // pairs with sleepers wherever they lie (a resting pile of sleepers made
 // pairs_count the largest pass of its step, every sleeper walking 14 cells
 // for nothing).
 fn walk(i: u32) {
-    walker = Walker(i, state_in[i].pos, pair_meta[i].extent, pair_meta[i].bound, pair_meta[i].moves == MOVES,
-                    vec2<u32>(joint_start[i], joint_start[i + 1u]));
+    let extent = pair_meta[i].extent;
+    let size = box_size(extent);
+    let grid = in_grid(i);
+    let sleeps = pair_meta[i].moves == SLEEPS;
+    walker = Walker(i, state_in[i].pos, extent, pair_meta[i].bound, size, pair_meta[i].moves == MOVES,
+                    grid && is_fast(size, pair_meta[i].moves), vec2<u32>(joint_start[i], joint_start[i + 1u]));
     owned = 0u;
     if (wants_ground(i)) {
         if (writing) {
@@ -239,14 +277,28 @@ fn walk(i: u32) {
         }
         owned = owned + 1u;
     }
-    let grid = in_grid(i);
-    let sleeps = pair_meta[i].moves == SLEEPS;
-    let cells = select(select(14u, 27u, walker.moves && atomicLoad(&status[11]) != 0u), 0u, sleeps || !grid);
+    // one ring out: the own cell and the 13 ahead (and the 13 behind for
+    // sleepers); a fast walker: the own cell and the cubes' halves ahead
+    // and behind, or every bucket when the grid has fewer
+    let rings = select(1u, rings_of(size), walker.fast);
+    let side = 2u * rings + 1u;
+    let ahead = (side * side * side - 1u) / 2u;
+    let both = walker.fast || (walker.moves && atomicLoad(&status[11]) != 0u);
+    var cells = select(select(1u + ahead, 1u + 2u * ahead, both), 0u, sleeps || !grid);
+    let every = walker.fast && f32(side) * f32(side) * f32(side) >= f32(params.hash_size);
+    cells = select(cells, params.hash_size, every);
     let centre = cell_of(walker.pos);
     // one loop, one call site: the kernel holds one copy of the cell's walk
     // (lavapipe's compile time grows steeply with a kernel's size)
+    var o = vec3<i32>(0);
     for (var n = 0u; n < cells; n = n + 1u) {
-        visit_cell(centre + walk_cell(n), select(NONE, i, n == 0u), n > 13u);
+        // the own cell, the cells ahead, then the same cells behind
+        let behind = n > ahead;
+        if (n != 0u) {
+            o = next_cell(o, select(n, n - ahead, behind), rings);
+        }
+        let c = centre + select(o, -o, behind);
+        visit_bucket(select(bucket_of(c), n, every), c, every, select(NONE, i, n == 0u), behind);
     }
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         let j = large_body(k);

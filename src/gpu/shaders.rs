@@ -37,6 +37,7 @@ pub fn shared_constants() -> String {
         ("WOKEN_NOW", WOKEN_NOW),
         ("BODY_BITS", BODY_BITS),
         ("MOVES_SHIFT", MOVES_SHIFT),
+        ("FAST_BODY", FAST_BODY),
         ("NO_FAULT", NO_FAULT),
         ("FAULT_NON_FINITE", FaultKind::NonFinite as u32),
         ("FAULT_FAR", FaultKind::TooFar as u32),

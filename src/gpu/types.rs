@@ -181,9 +181,11 @@ pub struct EndSnap {
 }
 
 /// `CellBound::body`: the body's index in the low bits (`BODY_BITS`),
+/// `FAST_BODY` if the body is fast (shaders/grid.wgsl's `is_fast`),
 /// `PairMeta::moves` from bit `MOVES_SHIFT` on (shared with WGSL).
 pub const MOVES_SHIFT: u32 = 30;
-pub const BODY_BITS: u32 = (1 << MOVES_SHIFT) - 1;
+pub const FAST_BODY: u32 = 1 << 29;
+pub const BODY_BITS: u32 = FAST_BODY - 1;
 
 /// A grid body's bounds as the pair walks read them, in the grid's order
 /// (32 bytes); see `CellBound` in common.wgsl.
@@ -196,8 +198,9 @@ pub struct CellBound {
     pub bound: f32,
     /// Half extents of the world box grown by the reach (m).
     pub extent: [f32; 3],
-    /// The body's index, and in the top two bits `PairMeta::moves` (an
-    /// index fits `BODY_BITS`: `world::max_bodies` holds worlds within it).
+    /// The body's index, `FAST_BODY` if it is fast, and in the top two bits
+    /// `PairMeta::moves` (an index fits `BODY_BITS`: `world::max_bodies`
+    /// holds worlds within it).
     pub body: u32,
 }
 

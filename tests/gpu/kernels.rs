@@ -5,7 +5,7 @@
 use crate::common::Rng;
 use crate::common::{step_until_asleep, world};
 use glam::{Quat, Vec3};
-use verlet::gpu::types::{CellBound, PairMeta, MOVES_SHIFT, SCAN_SPAN};
+use verlet::gpu::types::{CellBound, PairMeta, FAST_BODY, MOVES_SHIFT, SCAN_SPAN};
 use verlet::scenes::{self, box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
 use verlet::world::plan_grid;
@@ -121,7 +121,11 @@ fn assert_cell_bounds(w: &verlet::World, n: usize) -> Vec<u32> {
         let mut want: Vec<u32> = states[i].pos.iter().map(|v| v.to_bits()).collect();
         want.push(word(i, std::mem::offset_of!(PairMeta, bound)));
         want.extend((0..3).map(|c| word(i, std::mem::offset_of!(PairMeta, extent) + 4 * c)));
-        want.push(i as u32 | moves << MOVES_SHIFT);
+        // FAST_BODY: a grown box larger than grid.wgsl's fast_size (not a sleeper)
+        let extent = (0..3).map(|c| f32::from_bits(word(i, std::mem::offset_of!(PairMeta, extent) + 4 * c)));
+        let fast_size = 0.5 * (0.999 * w.grid().cell_size - verlet::world::CONTACT_MARGIN);
+        let fast = if extent.fold(0.0, f32::max) > fast_size && moves != SLEEPS { FAST_BODY } else { 0 };
+        want.push(i as u32 | fast | moves << MOVES_SHIFT);
         assert_eq!(&bounds[record * k..record * (k + 1)], &want[..], "cell_bounds[{k}] (body {i})");
         if !seen.contains(&moves) {
             seen.push(moves);
@@ -209,6 +213,109 @@ fn grid_count_bounds_each_body_by_its_move_and_turn() {
             assert!(spin > 0.2, "the fast spinner's spin reach {spin}");
         }
     }
+}
+
+/// The pair list (pairs_count, the pair scan, pairs_write) holds every
+/// candidate pair once, whatever the bodies' speeds: a pair whose bounds
+/// (pair_meta's sphere and box, grown by each body's reach) come within
+/// CONTACT_MARGIN, against the CPU's test of every pair of the 400 bodies.
+/// A fifth of them move at 20 to 2000 m/s, so their reach spans several
+/// grid cells; before the walks counted the fast bodies' reach, the pairs
+/// of a fast body with bodies more than a cell away were never listed, and
+/// a cube thrown at 45 m/s ended inside the one it hit.
+#[test]
+fn the_pair_list_holds_every_pair_within_reach_once_at_any_speed() {
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut bodies = Vec::new();
+    for k in 0..400 {
+        let at = [rng.range(-7.0, 7.0), rng.range(0.0, 5.0), rng.range(-7.0, 7.0)];
+        let mut b = if k % 3 == 0 {
+            sphere_body(rng.range(0.2, 0.45), at)
+        } else {
+            box_body([rng.range(0.2, 0.5), rng.range(0.2, 0.5), rng.range(0.2, 0.5)], at)
+        };
+        b.orientation = rng.quat().to_array();
+        let speed = if k % 5 == 0 { [20.0, 45.0, 80.0, 150.0, 400.0, 2000.0][k / 5 % 6] } else { rng.range(0.0, 3.0) };
+        let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize();
+        b.linear_velocity = (dir * speed).to_array();
+        b.angular_velocity = [rng.range(-20.0, 20.0), rng.range(-20.0, 20.0), rng.range(-20.0, 20.0)];
+        b.fixed = k % 11 == 0;
+        bodies.push(b);
+    }
+    // a slab too large for the cells (kept out of the grid)
+    bodies.push(box_body([9.0, 0.3, 9.0], [0.0, -0.5, 0.0]));
+    let n = bodies.len();
+    let scene = Scene {
+        settings: Settings { gravity: [0.0; 3], ..Settings::default() },
+        ground: None,
+        bodies,
+        joints: vec![],
+        camera: None,
+    };
+    let Some(mut w) = world(&scene) else { return };
+    let stages: Vec<Stage> =
+        w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
+    // steps, until the pair list has grown to hold the fast bodies' pairs
+    let mut report = w.contact_report().unwrap();
+    for _ in 0..4 {
+        w.run_stages(&stages).unwrap();
+        report = w.contact_report().unwrap();
+        if report.pairs <= report.pair_capacity {
+            break;
+        }
+        w.step(1).unwrap();
+    }
+    assert!(report.pairs <= report.pair_capacity, "the list dropped pairs: {report:?}");
+    // the fast bodies marked in cell_bounds
+    assert_cell_bounds(&w, n - 1);
+    let bounds: Vec<CellBound> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::CellBounds).unwrap());
+    let fast = bounds[..n - 1].iter().filter(|b| b.body & FAST_BODY != 0).count();
+    assert!(fast >= 40, "fast bodies marked: {fast}");
+    let words = w.read_words(Buffer::Pairs).unwrap();
+    let mut listed: Vec<(u32, u32)> =
+        words.chunks(2).take(report.pairs as usize).map(|p| (p[0].min(p[1]), p[0].max(p[1]))).collect();
+    listed.sort();
+    let before = listed.len();
+    listed.dedup();
+    assert_eq!(listed.len(), before, "a pair listed twice");
+
+    let states = w.read_raw().unwrap();
+    let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
+    let cell = w.grid().cell_size;
+    let margin = verlet::world::CONTACT_MARGIN;
+    // how far the pair is from wanted_bounds's limits (pairs.wgsl): > 0
+    // wanted, < 0 not; within a rounding of 0 either may be
+    let inside = |i: usize, j: usize| -> f32 {
+        let (a, b) = (&meta[i], &meta[j]);
+        if a.moves != MOVES && b.moves != MOVES {
+            return -1.0;
+        }
+        let d = Vec3::from(states[i].pos) - Vec3::from(states[j].pos);
+        let sphere = a.bound + b.bound + margin - d.length();
+        let apart = d.abs() - Vec3::from(a.extent) - Vec3::from(b.extent);
+        sphere.min(margin - apart.max_element())
+    };
+    let (mut wanted, mut far) = (0, 0);
+    for i in 0..n {
+        for j in i + 1..n {
+            let slack = inside(i, j);
+            let found = listed.binary_search(&(i as u32, j as u32)).is_ok();
+            let reach = 1e-4 * (1.0 + meta[i].reach + meta[j].reach);
+            if slack > reach {
+                assert!(found, "pair ({i}, {j}) within reach ({slack} m inside) is not listed");
+                wanted += 1;
+                let d = (Vec3::from(states[i].pos) - Vec3::from(states[j].pos)).abs();
+                far += usize::from(d.max_element() > cell);
+            } else if slack < -reach {
+                assert!(!found, "pair ({i}, {j}) out of reach ({slack} m) is listed");
+            }
+        }
+    }
+    eprintln!(
+        "{wanted} pairs within reach, {far} of them more than a cell ({cell} m) apart along an axis; {} listed",
+        listed.len()
+    );
+    assert!(far >= 20, "too few pairs beyond the neighbouring cells to test the fast walks: {far}");
 }
 
 #[test]

@@ -125,6 +125,7 @@ fn constants_match() {
         ("WOKEN_NOW", WOKEN_NOW),
         ("BODY_BITS", BODY_BITS),
         ("MOVES_SHIFT", MOVES_SHIFT),
+        ("FAST_BODY", FAST_BODY),
         ("MAX_POINTS", MAX_POINTS),
         ("NONE", NONE),
         ("GROUND", GROUND),
