@@ -50,13 +50,7 @@ fn grid_sort_matches_a_counting_sort(n: usize) {
     // two bodies too large for the cells
     bodies.push(box_body([6.0, 0.5, 6.0], [0.0, -3.0, 0.0]));
     bodies.push(sphere_body(4.0, [10.0, 10.0, 10.0]));
-    let scene = Scene {
-        settings: Settings { gravity: [0.0; 3], ..Settings::default() },
-        ground: None,
-        bodies,
-        joints: vec![],
-        camera: None,
-    };
+    let scene = weightless(bodies);
     let Some(mut w) = world(&scene) else { return };
     let stages: Vec<Stage> = w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase()).collect();
     assert_eq!(stages.len(), if blocks > 1 { grid_stages().len() } else { grid_stages().len() - 2 }, "{stages:?}");
@@ -97,6 +91,11 @@ fn grid_sort_matches_a_counting_sort(n: usize) {
     assert_eq!(cell_start[..starts.len()], starts[..], "cell_start");
     let moves = assert_cell_bounds(&w, n);
     assert!(moves.contains(&STAYS_FIXED) && moves.contains(&MOVES), "{moves:?}");
+}
+
+/// `bodies` with no ground and no gravity.
+fn weightless(bodies: Vec<verlet::Body>) -> Scene {
+    Scene { settings: Settings { gravity: [0.0; 3], ..Settings::default() }, ground: None, bodies, joints: vec![], camera: None }
 }
 
 // PairMeta::moves (common.wgsl)
@@ -245,13 +244,7 @@ fn the_pair_list_holds_every_pair_within_reach_once_at_any_speed() {
     // a slab too large for the cells (kept out of the grid)
     bodies.push(box_body([9.0, 0.3, 9.0], [0.0, -0.5, 0.0]));
     let n = bodies.len();
-    let scene = Scene {
-        settings: Settings { gravity: [0.0; 3], ..Settings::default() },
-        ground: None,
-        bodies,
-        joints: vec![],
-        camera: None,
-    };
+    let scene = weightless(bodies);
     let Some(mut w) = world(&scene) else { return };
     let stages: Vec<Stage> =
         w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
