@@ -79,7 +79,7 @@ fn spin_reach_of(i: u32) -> f32 {
 // cm; tests/gpu/kernels.rs,
 // the_pair_list_holds_every_pair_within_reach_once_at_any_speed). In a
 // pile of 10 000 cubes dropped from up to 5.7 m, at most four bodies of a
-// step are fast.
+// step are fast (by a trace of their speeds and spins).
 fn fast_size() -> f32 {
     // a thousandth of a cell of slack for the rounding of the cells
     return 0.5 * (0.999 * params.cell_size - CONTACT_MARGIN);

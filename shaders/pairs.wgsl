@@ -34,10 +34,10 @@
 // walks them all); a large body (kept out of the grid) owns only its pairs
 // with large bodies of higher index, so it never walks the cells; every
 // body owns its pair with the ground. A fast body (`is_fast`) walks every
-// cell within its reach instead, and owns its pairs with all it finds there
-// but the faster bodies (`outranks`); no other walk takes a pair with it. A pair is wanted when the two
-// bodies' bounds come within the margin, they are not joined, and one of
-// them moves: not fixed and awake, or asleep but woken by the last step's
+// cell within its reach instead, and owns its pairs with all it finds
+// there but the faster bodies (`outranks`); no other walk takes a pair
+// with it. A pair is wanted when the two bodies' bounds come within the
+// margin, they are not joined, and one of them moves: not fixed and awake, or asleep but woken by the last step's
 // narrowphase (pair_meta's MOVES). Only the owner decides, alike in both
 // walks (the test reads only what these passes do not write).
 
@@ -255,12 +255,11 @@ fn next_cell(o: vec3<i32>, m: u32, rings: u32) -> vec3<i32> {
 
 // The ground, then (for a body in the grid) its own cell and the 13 cells
 // ahead of it, and the 13 behind it for sleepers where any grid body
-// sleeps (a fast body: every cell within its reach), then the large bodies
-// it owns pairs with. A sleeper walks no
-// cells: pairs of sleepers are not wanted, and a body that moves owns its
-// pairs with sleepers wherever they lie (a resting pile of sleepers made
-// pairs_count the largest pass of its step, every sleeper walking 14 cells
-// for nothing).
+// sleeps (a fast body: every cell within its reach), then the large
+// bodies it owns pairs with. A sleeper walks no cells: pairs of sleepers
+// are not wanted, and a body that moves owns its pairs with sleepers
+// wherever they lie (a resting pile of sleepers made pairs_count the
+// largest pass of its step, every sleeper walking 14 cells for nothing).
 fn walk(i: u32) {
     let extent = pair_meta[i].extent;
     let size = box_size(extent);
