@@ -38,13 +38,13 @@ fn bucket_of(c: vec3<i32>) -> u32 {
 }
 
 fn in_grid(i: u32) -> bool {
-    return props[i].grid_class == GRID_BODY;
+    return props_of(i).grid_class == GRID_BODY;
 }
 
 // How far body i may move in the coming step, all its substeps (m): its last
 // displacement, rescaled to this step, plus what gravity adds.
 fn reach_of(i: u32) -> f32 {
-    let s = state_in[i];
+    let s = state_of(i);
     let steps = f32(params.substeps);
     let ratio = params.dt / params.dt_prev * steps;
     let h = params.dt * steps;
@@ -57,8 +57,8 @@ fn reach_of(i: u32) -> f32 {
 // bounding radius R, a substep; rescaled as reach_of. (q and -q are one
 // rotation: d is the nearer of the two.) A sphere turns into itself: 0.
 fn spin_reach_of(i: u32) -> f32 {
-    let s = state_in[i];
-    let p = props[i];
+    let s = state_of(i);
+    let p = props_of(i);
     let ratio = params.dt / params.dt_prev * f32(params.substeps);
     let turned = min(length(s.rot - s.prev_rot), length(s.rot + s.prev_rot));
     return select(2.0 * turned * p.half_extents.w * ratio, 0.0, p.shape == SHAPE_SPHERE);
@@ -98,11 +98,11 @@ fn is_fast(size: f32, moves: u32) -> bool {
 
 // Half extents of body i's world box: |R| h for a box, the radius for a sphere.
 fn world_extent(i: u32) -> vec3<f32> {
-    let p = props[i];
+    let p = props_of(i);
     if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(p.half_extents.x);
     }
-    let q = state_in[i].rot;
+    let q = state_of(i).rot;
     let x = quat_rotate(q, vec3<f32>(p.half_extents.x, 0.0, 0.0));
     let y = quat_rotate(q, vec3<f32>(0.0, p.half_extents.y, 0.0));
     let z = quat_rotate(q, vec3<f32>(0.0, 0.0, p.half_extents.z));
@@ -131,8 +131,8 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     sorted[params.body_count + i] = NONE; // no body listed here yet
     let reach = reach_of(i);
     let spin = spin_reach_of(i);
-    let fixed = is_fixed(props[i]);
-    let moves = !fixed && (!asleep(state_in[i]) || (state_in[i].pos_low & WAKES) != 0u);
+    let fixed = is_fixed(props_of(i));
+    let moves = !fixed && (!asleep(state_of(i)) || (state_of(i).pos_low & WAKES) != 0u);
     let sleeps = !fixed && !moves;
     pair_meta[i].moves = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
@@ -140,7 +140,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     pair_meta[i].spin = spin;
     pair_meta[i].extent = world_extent(i) + vec3<f32>(reach + spin);
     // the bounding sphere turns into itself: only the centre's move grows it
-    pair_meta[i].bound = props[i].half_extents.w + reach;
+    pair_meta[i].bound = props_of(i).half_extents.w + reach;
     if (!in_grid(i)) {
         return;
     }
@@ -149,7 +149,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (sleeps && atomicLoad(&status[11]) == 0u) {
         atomicStore(&status[11], 1u);
     }
-    atomicAdd(&cell_count[bucket_of(cell_of(state_in[i].pos))], 1u);
+    atomicAdd(&cell_count[bucket_of(cell_of(state_of(i).pos))], 1u);
 }
 
 // Which prefix sum the scan passes compute (set per pipeline, see above).
@@ -298,7 +298,7 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count || !in_grid(i)) {
         return;
     }
-    let h = bucket_of(cell_of(state_in[i].pos));
+    let h = bucket_of(cell_of(state_of(i).pos));
     // from the bucket's start as the count goes down (in arrival order,
     // which is mostly by index: grid_sort then has little to move)
     sorted[cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
@@ -307,7 +307,7 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
 // A grid body's key in its bucket: the low x side of its world box grown
 // by its reach (pair_meta's extent, written by grid_count).
 fn grid_key(i: u32) -> f32 {
-    return state_in[i].pos.x - pair_meta[i].extent.x;
+    return state_of(i).pos.x - pair_meta[i].extent.x;
 }
 
 // Whether body a comes before body b in their bucket: by key, then index.
@@ -345,6 +345,6 @@ fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
         let moves = pair_meta[i].moves;
         let extent = pair_meta[i].extent;
         let fast = select(0u, FAST_BODY, is_fast(box_size(extent), moves));
-        cell_bounds[k] = CellBound(state_in[i].pos, pair_meta[i].bound, extent, i | fast | (moves << MOVES_SHIFT));
+        set_cell_bound(k, CellBound(state_of(i).pos, pair_meta[i].bound, extent, i | fast | (moves << MOVES_SHIFT)));
     }
 }

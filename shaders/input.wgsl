@@ -158,13 +158,13 @@ fn apply_inputs(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let i = first.body;
-    var s = state_out[i];
+    var s = out_state(i);
     var p = props_rw[i];
     let p0 = p;
     for (var j = k; j < k + first.run; j = j + 1u) {
         s = apply_op(input_ops[j], s, &p);
     }
-    state_out[i] = s;
+    set_state(i, s);
     if (p.flags != p0.flags || any(p.inv_inertia != p0.inv_inertia) || p.kept_inv_mass != p0.kept_inv_mass) {
         props_rw[i] = p;
     }
@@ -175,8 +175,8 @@ fn apply_inputs(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(WORKGROUP)
 fn wake_all(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i < input.counts.x && state_out[i].rest_time != 0.0) {
-        state_out[i].rest_time = 0.0;
+    if (i < input.counts.x && out_state(i).rest_time != 0.0) {
+        set_rest_time(i, 0.0);
     }
 }
 
@@ -195,7 +195,7 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (is_fixed(p)) {
         return;
     }
-    var s = state_out[i];
+    var s = out_state(i);
     let d = s.pos - input.centre.xyz;
     let dist = length(d);
     let radius = input.reach.x;
@@ -215,7 +215,7 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let dv = dir * (input.centre.w * scale * p.inv_inertia.w);
     s.disp = s.disp + dv * input.substep_dt;
-    state_out[i] = s;
+    set_state(i, s);
 }
 
 // Area (m^2) of the body's shape seen along the unit world direction u.
@@ -241,7 +241,7 @@ fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (is_fixed(p)) {
         return;
     }
-    var s = state_out[i];
+    var s = out_state(i);
     let h = input.substep_dt;
     let v = s.disp / h;
     let rel = input.centre.xyz - v; // wind relative to the body
@@ -253,5 +253,5 @@ fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
     let left = rel / (1.0 + k * speed * input.reach.x);
     let dv = rel - left;
     s.disp = s.disp + dv * h;
-    state_out[i] = s;
+    set_state(i, s);
 }

@@ -151,11 +151,11 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    let p = props[i];
+    let p = props_of(i);
     // the last substep's restitution first (restitution.wgsl's body half,
     // `restituted`; none before a step's first substep, which follows the
     // pass "restitution")
-    let s = restituted(i, state_in[i], p, params.substep != 0u);
+    let s = restituted(i, state_of(i), p, params.substep != 0u);
     let dt = params.dt;
     let wake = params.substep == 0u && (s.pos_low & WAKES) != 0u;
     let wakes = wakes_next(i, s);
@@ -180,13 +180,13 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         } else if (usable_rotation(s.prev_rot)) {
             q = normalize(s.prev_rot);
         }
-        state_out[i] = BodyState(at, 0.0, vec3<f32>(0.0), 0u, q, q);
+        set_state(i, BodyState(at, 0.0, vec3<f32>(0.0), 0u, q, q));
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         moved();
         return;
     }
     if (is_fixed(p)) {
-        state_out[i] = BodyState(s.pos, s.rest_time, vec3<f32>(0.0), HELD, s.rot, s.rot);
+        set_state(i, BodyState(s.pos, s.rest_time, vec3<f32>(0.0), HELD, s.rot, s.rot));
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
@@ -207,7 +207,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     if (rest >= params.sleep_after && rest > 0.0) {
         // asleep: held still where it is (resting on what pressed it)
-        state_out[i] = BodyState(s.pos, rest, vec3<f32>(0.0), (s.pos_low & ~WAKES) | HELD | wakes, s.rot, s.rot);
+        set_state(i, BodyState(s.pos, rest, vec3<f32>(0.0), (s.pos_low & ~WAKES) | HELD | wakes, s.rot, s.rot));
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         if (wakes != 0u) {
             moved();
@@ -241,7 +241,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rot = normalize(quat_mul(turn, s.rot));
     let spin = quat_to_rotvec(turn);
 
-    state_out[i] = BodyState(pos, rest, disp, pack_remainder(dropped, pos, (s.pos_low & HELD) | wakes), rot, s.rot);
+    set_state(i, BodyState(pos, rest, disp, pack_remainder(dropped, pos, (s.pos_low & HELD) | wakes), rot, s.rot));
     vel0[i] = Velocity(vec4<f32>(disp / dt, 0.0), vec4<f32>(spin / dt, 0.0));
     moved();
 }

@@ -13,13 +13,13 @@
 // (WOKEN_NOW; see pairs.wgsl and integrate.wgsl).
 
 fn shape_of(i: u32) -> Shape {
-    let s = state_in[i];
-    let p = props[i];
+    let s = state_of(i);
+    let p = props_of(i);
     return Shape(s.pos, s.rot, p.half_extents.xyz, p.shape);
 }
 
 fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
-    let s = state_in[i];
+    let s = state_of(i);
     return quat_rotate(quat_conj(s.rot), p - s.pos);
 }
 
@@ -27,8 +27,8 @@ fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
 // the box corners within the margin (at most four: the deepest, listed in
 // corner order). The normal points from the body to the ground.
 fn ground_manifold(i: u32, margin: f32) -> Manifold {
-    let s = state_in[i];
-    let p = props[i];
+    let s = state_of(i);
+    let p = props_of(i);
     let ground = params.ground_height;
     var m = empty_manifold();
     m.normal = vec3<f32>(0.0, -1.0, 0.0);
@@ -89,7 +89,7 @@ fn corner(k: u32, h: vec3<f32>) -> vec3<f32> {
 
 // Wakes `sleeper` if `other` is awake, moves, and is fast or `gap` deep in it.
 fn wake_check(sleeper: u32, other: u32, gap: f32) {
-    if (asleep(state_in[sleeper]) && !is_fixed(props[other]) && wakes(other, gap)) {
+    if (asleep(state_of(sleeper)) && !is_fixed(props_of(other)) && wakes(other, gap)) {
         atomicOr(&pair_meta[sleeper].woken, WOKEN_NOW);
     }
 }
@@ -110,13 +110,13 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
             deepest = min(deepest, dot(m.on_b[k] - m.on_a[k], m.normal));
         }
     }
-    manifolds[slot] = ContactManifold(m.normal, m.count, a, b, NONE, pair);
+    set_manifold(slot, ContactManifold(m.normal, m.count, a, b, NONE, pair));
     store_points(slot, kept);
     // only an awake partner wakes a sleeper, so of the two checks (a by b,
     // b by a) only the one for a sleeping a can act if a sleeps, only the
     // other if not: one check, one copy of it in the kernel
     if (b != GROUND && m.count > 0u) {
-        let a_sleeps = asleep(state_in[a]);
+        let a_sleeps = asleep(state_of(a));
         wake_check(select(b, a, a_sleeps), select(a, b, a_sleeps), deepest);
     }
 }
@@ -193,12 +193,7 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     if (to_clip) {
         // pending: what narrowphase_clip needs (the points follow)
-        manifolds[slot].normal = axis.normal;
-        manifolds[slot].count = 0u;
-        manifolds[slot].a = pr.a;
-        manifolds[slot].b = pr.b;
-        manifolds[slot].clip_face = axis.face;
-        manifolds[slot].pair = p;
+        set_manifold(slot, ContactManifold(axis.normal, 0u, pr.a, pr.b, axis.face, p));
         return;
     }
     if (boxes) {
@@ -244,13 +239,13 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
         return;
     }
     let k = arrayLength(&manifolds) - 1u - nth;
-    let face = manifolds[k].clip_face;
-    let ia = manifolds[k].a;
-    let ib = manifolds[k].b;
+    let face = manifold_of(k).clip_face;
+    let ia = manifold_of(k).a;
+    let ib = manifold_of(k).b;
     let a = shape_of(ia);
     let b = shape_of(ib);
-    let m = box_box_face(a.centre, a.rot, a.half, b.centre, b.rot, b.half, manifolds[k].normal, face, pair_margin(ia, ib));
-    store_manifold(k, ia, ib, manifolds[k].pair, m);
+    let m = box_box_face(a.centre, a.rot, a.half, b.centre, b.rot, b.half, manifold_of(k).normal, face, pair_margin(ia, ib));
+    store_manifold(k, ia, ib, manifold_of(k).pair, m);
 }
 
 // Pass "contact_lists", once after the narrowphase, one invocation per body:
@@ -297,15 +292,15 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     // a manifold narrowphase_clip still has to clip, with a partner that
     // moves, may wake the body; so may one its list lost, where it overflowed
     var may_wake = first + atomicLoad(&pair_meta[i].cursor) > arrayLength(&body_pairs);
-    let w = props[i].inv_inertia.w;
+    let w = props_of(i).inv_inertia.w;
     for (var k = first; k < end; k = k + 1u) {
         let r = body_pairs[k];
-        let partner = select(manifolds[r >> 1u].b, manifolds[r >> 1u].a, (r & 1u) != 0u);
+        let partner = select(manifold_of(r >> 1u).b, manifold_of(r >> 1u).a, (r & 1u) != 0u);
         let stays = partner == GROUND || !contact_end_moves(partner);
         held = held + u32(stays);
         if (!stays) {
-            movers = movers + w / max(w + props[partner].inv_inertia.w, 1e-30);
-            may_wake = may_wake || manifolds[r >> 1u].clip_face != NONE;
+            movers = movers + w / max(w + props_of(partner).inv_inertia.w, 1e-30);
+            may_wake = may_wake || manifold_of(r >> 1u).clip_face != NONE;
         }
     }
     pair_meta[i].held = held;
@@ -329,7 +324,7 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
 // from a snapshot, is listed so that integrate finds the fault); not on a
 // joint (solve_joints shares rest times within an island, in place).
 fn sleeps_held(i: u32) -> bool {
-    let s = state_in[i];
+    let s = state_of(i);
     let still = all(bitcast<vec3<u32>>(s.disp) == vec3<u32>(0u)) && all(bitcast<vec4<u32>>(s.prev_rot) == bitcast<vec4<u32>>(s.rot));
     let held = still && (s.pos_low & HELD) != 0u && near(s.pos) && all_finite(s.rot);
     return pair_meta[i].moves == SLEEPS && held && !is_jointed(i);
@@ -340,5 +335,5 @@ fn sleeps_held(i: u32) -> bool {
 // writes its pairs in walk order; a pair index stays below 2^31, see
 // world.rs's pair_capacities).
 fn list_order(r: u32) -> u32 {
-    return manifolds[r >> 1u].pair | select(0x80000000u, 0u, (r & 1u) != 0u);
+    return manifold_of(r >> 1u).pair | select(0x80000000u, 0u, (r & 1u) != 0u);
 }

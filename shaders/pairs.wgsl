@@ -75,7 +75,7 @@ fn joined_to_walker(j: u32) -> bool {
 fn pair_margin(lo: u32, hi: u32) -> f32 {
     let steps = f32(params.substeps);
     let h = params.dt * steps;
-    let relative = length(state_in[lo].disp - state_in[hi].disp) * (params.dt / params.dt_prev * steps)
+    let relative = length(state_of(lo).disp - state_of(hi).disp) * (params.dt / params.dt_prev * steps)
         + length(params.gravity) * h * h + pair_meta[lo].spin + pair_meta[hi].spin;
     return CONTACT_MARGIN + min(relative, pair_meta[lo].reach + pair_meta[hi].reach);
 }
@@ -106,7 +106,7 @@ fn wanted_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u
 // Whether body i is near enough the ground for a ground pair.
 fn wants_ground(i: u32) -> bool {
     return params.has_ground != 0u && pair_meta[i].moves == MOVES
-        && state_in[i].pos.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
+        && state_of(i).pos.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
 }
 
 // Whether the walker owns its pair with body j (box size `size_j`) when one
@@ -200,7 +200,7 @@ fn visit_bucket(h: u32, c: vec3<i32>, any_cell: bool, above: u32, behind: bool) 
     let end = cell_start[h + 1u];
     let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
     for (var k = cell_start[h]; k < end; k = k + 1u) {
-        let cb = cell_bounds[k];
+        let cb = cell_bound_of(k);
         if (cb.pos.x - cb.extent.x > stop) {
             break;
         }
@@ -265,7 +265,7 @@ fn walk(i: u32) {
     let size = box_size(extent);
     let grid = in_grid(i);
     let sleeps = pair_meta[i].moves == SLEEPS;
-    walker = Walker(i, state_in[i].pos, extent, pair_meta[i].bound, size, pair_meta[i].moves == MOVES,
+    walker = Walker(i, state_of(i).pos, extent, pair_meta[i].bound, size, pair_meta[i].moves == MOVES,
                     grid && is_fast(size, pair_meta[i].moves), vec2<u32>(joint_start[i], joint_start[i + 1u]));
     owned = 0u;
     if (wants_ground(i)) {
@@ -301,7 +301,7 @@ fn walk(i: u32) {
     }
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         let j = large_body(k);
-        if ((grid || j > i) && wanted_bounds(state_in[j].pos, pair_meta[j].bound, pair_meta[j].extent, pair_meta[j].moves)
+        if ((grid || j > i) && wanted_bounds(state_of(j).pos, pair_meta[j].bound, pair_meta[j].extent, pair_meta[j].moves)
             && !joined_to_walker(j)) {
             take(j);
         }

@@ -61,12 +61,12 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         return;
     }
     let k = pool_slot(nth, used);
-    let a = manifolds[k].a;
-    let b = manifolds[k].b;
+    let a = manifold_of(k).a;
+    let b = manifold_of(k).b;
     let ea = contact_end(a);
     let eb = contact_end(b);
-    let n = manifolds[k].normal; // from a to b
-    let count = manifolds[k].count;
+    let n = manifold_of(k).normal; // from a to b
+    let count = manifold_of(k).count;
     let at = point_slot(k);
     if (!ea.moves && !eb.moves) {
         for (var q = 0u; q < count; q = q + 1u) {
@@ -222,5 +222,5 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    state_out[i] = restituted(i, state_in[i], props[i], true);
+    set_state(i, restituted(i, state_of(i), props_of(i), true));
 }

@@ -124,16 +124,16 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let k = pool_slot(nth, used);
     // the header, read once (the pool is written here, so a second read
     // is a second load: a loop over the lanes on lavapipe)
-    let a = manifolds[k].a;
-    let b = manifolds[k].b;
-    let count = manifolds[k].count;
+    let a = manifold_of(k).a;
+    let b = manifold_of(k).b;
+    let count = manifold_of(k).count;
     let at = point_slot(k);
     var ea = contact_end(a);
     var eb = contact_end(b);
     if (!ea.moves && !eb.moves) {
         return; // neither body reads its snap
     }
-    let n = manifolds[k].normal; // from a to b: a is pushed along -n, b along n
+    let n = manifold_of(k).normal; // from a to b: a is pushed along -n, b along n
     // the lower body of a stacked pair counts SHOCK times its inverse mass
     // (up_n: n's component against gravity; > 0: b lies above a)
     let g = length(params.gravity);
@@ -261,10 +261,10 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    var s = state_in[i];
-    let p = props[i];
+    var s = state_of(i);
+    let p = props_of(i);
     if (is_fixed(p) || asleep(s)) {
-        state_out[i] = s;
+        set_state(i, s);
         return;
     }
     var acc = Snap(vec3<f32>(0.0), vec3<f32>(0.0));
@@ -344,7 +344,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         s.rot = quat_add_rotation(s.rot, settle.dtheta * share);
         s.prev_rot = quat_add_rotation(s.prev_rot, settle.dtheta * share);
     }
-    state_out[i] = s;
+    set_state(i, s);
 }
 
 // Pass "solve_joints", after every solve: ball joints closed one after the
@@ -370,10 +370,10 @@ fn close_joint(j: JointRef) {
     let a = j.body;
     let joined = j.partner != WORLD;
     let b = select(a, j.partner, joined);
-    var sa = state_out[a];
-    var sb = state_out[b];
-    let pa = props[a];
-    let pb = props[b];
+    var sa = out_state(a);
+    var sb = out_state(b);
+    let pa = props_of(a);
+    let pb = props_of(b);
     let ra = quat_rotate(sa.rot, j.local_self);
     let rb = quat_rotate(sb.rot, j.local_partner);
     let gap = select(j.local_partner, sb.pos + rb, joined) - (sa.pos + ra);
@@ -401,14 +401,14 @@ fn close_joint(j: JointRef) {
         sa.pos = sa.pos + dx;
         sa.disp = sa.disp + dx;
         sa.rot = quat_add_rotation(sa.rot, inv_inertia_world(sa.rot, pa.inv_inertia.xyz, cross(ra, n)) * lambda);
-        state_out[a] = sa;
+        set_state(a, sa);
     }
     if (wb > 0.0) {
         let dx = n * (-pb.inv_inertia.w * lambda);
         sb.pos = sb.pos + dx;
         sb.disp = sb.disp + dx;
         sb.rot = quat_add_rotation(sb.rot, inv_inertia_world(sb.rot, pb.inv_inertia.xyz, cross(rb, n)) * -lambda);
-        state_out[b] = sb;
+        set_state(b, sb);
     }
 }
 
@@ -430,13 +430,13 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     var held = false;
     for (var e = first; e < end; e = e + 1u) {
         let j = joint_refs[e];
-        let s = state_out[j.body];
+        let s = out_state(j.body);
         rest = min(rest, s.rest_time);
         held = held || (s.pos_low & HELD) != 0u;
-        if (j.partner == WORLD || is_fixed(props[j.partner])) {
+        if (j.partner == WORLD || is_fixed(props_of(j.partner))) {
             held = true;
         } else {
-            let o = state_out[j.partner];
+            let o = out_state(j.partner);
             rest = min(rest, o.rest_time);
             held = held || (o.pos_low & HELD) != 0u;
         }
@@ -446,10 +446,10 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     for (var e = first; e < end; e = e + 1u) {
-        state_out[joint_refs[e].body].rest_time = rest;
+        set_rest_time(joint_refs[e].body, rest);
         let partner = joint_refs[e].partner;
-        if (partner != WORLD && !is_fixed(props[partner])) {
-            state_out[partner].rest_time = rest;
+        if (partner != WORLD && !is_fixed(props_of(partner))) {
+            set_rest_time(partner, rest);
         }
     }
     // params.joint_sweeps times forward then back, as one loop whose trip

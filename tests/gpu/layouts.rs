@@ -6,18 +6,24 @@ use std::mem::{offset_of, size_of};
 use naga::TypeInner;
 use verlet::gpu::{shaders, types::*};
 
+/// (member name, offset, size) of a WGSL struct's members, and its size.
+fn wgsl_struct(source: &str, name: &str) -> (Vec<(String, u32, u32)>, u32) {
+    let module = shaders::validate(source).expect("validates");
+    let (_, ty) = module
+        .types
+        .iter()
+        .find(|(_, ty)| ty.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("struct {name} not found in the WGSL"));
+    let TypeInner::Struct { members, span } = &ty.inner else { panic!("{name} is not a struct") };
+    let members =
+        members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset, module.types[m.ty].inner.size(module.to_ctx())));
+    (members.collect(), *span)
+}
+
 /// (member name, offset) of a WGSL struct, and its size.
 fn wgsl_layout(source: &str, name: &str) -> (Vec<(String, u32)>, u32) {
-    let module = shaders::validate(source).expect("validates");
-    for (_, ty) in module.types.iter() {
-        if ty.name.as_deref() == Some(name) {
-            if let TypeInner::Struct { members, span } = &ty.inner {
-                let m = members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect();
-                return (m, *span);
-            }
-        }
-    }
-    panic!("struct {name} not found in the WGSL");
+    let (members, span) = wgsl_struct(source, name);
+    (members.into_iter().map(|(name, offset, _)| (name, offset)).collect(), span)
 }
 
 macro_rules! check_layout {
@@ -91,6 +97,38 @@ fn shared_structs_match_member_by_member() {
             spin
         }
     );
+}
+
+/// The busiest buffers are bound as vec4 words (bindings.wgsl): each words
+/// struct spans its twin's bytes in 16-byte members only, and no member of
+/// the twin straddles two words, so each accessor's unpacking is a choice
+/// of components.
+#[test]
+fn stored_words_hold_their_structs_bytes() {
+    let common = &format!("{}{}{}", shaders::shared_constants(), shaders::COMMON, shaders::BINDINGS);
+    for (twin, words) in [
+        ("BodyState", "StateWords"),
+        ("BodyProps", "PropsWords"),
+        ("ContactManifold", "ManifoldWords"),
+        ("CellBound", "CellBoundWords"),
+        ("ManifoldPoints", "PointsWords"),
+        ("EndSnap", "SnapWords"),
+    ] {
+        let (twin_members, twin_span) = wgsl_struct(common, twin);
+        let (words_members, words_span) = wgsl_struct(common, words);
+        assert_eq!(words_span, twin_span, "{words} and {twin} differ in size");
+        let mut end = 0;
+        for (name, offset, size) in words_members {
+            assert_eq!(offset, end, "{words}.{name}: not right after the word before");
+            assert_eq!(size % 16, 0, "{words}.{name}: not whole vec4s");
+            end = offset + size;
+        }
+        for (name, offset, size) in twin_members {
+            if size <= 16 {
+                assert_eq!(offset / 16, (offset + size - 1) / 16, "{twin}.{name} straddles two words");
+            }
+        }
+    }
 }
 
 /// The constants WGSL shares with Rust are written once, from the Rust values
