@@ -239,13 +239,14 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
         return;
     }
     let k = arrayLength(&manifolds) - 1u - nth;
-    let face = manifold_of(k).clip_face;
-    let ia = manifold_of(k).a;
-    let ib = manifold_of(k).b;
+    let head = manifold_of(k);
+    let face = head.clip_face;
+    let ia = head.a;
+    let ib = head.b;
     let a = shape_of(ia);
     let b = shape_of(ib);
-    let m = box_box_face(a.centre, a.rot, a.half, b.centre, b.rot, b.half, manifold_of(k).normal, face, pair_margin(ia, ib));
-    store_manifold(k, ia, ib, manifold_of(k).pair, m);
+    let m = box_box_face(a.centre, a.rot, a.half, b.centre, b.rot, b.half, head.normal, face, pair_margin(ia, ib));
+    store_manifold(k, ia, ib, head.pair, m);
 }
 
 // Pass "contact_lists", once after the narrowphase, one invocation per body:
@@ -295,12 +296,13 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     let w = props_of(i).inv_inertia.w;
     for (var k = first; k < end; k = k + 1u) {
         let r = body_pairs[k];
-        let partner = select(manifold_of(r >> 1u).b, manifold_of(r >> 1u).a, (r & 1u) != 0u);
+        let head = manifold_of(r >> 1u);
+        let partner = select(head.b, head.a, (r & 1u) != 0u);
         let stays = partner == GROUND || !contact_end_moves(partner);
         held = held + u32(stays);
         if (!stays) {
             movers = movers + w / max(w + props_of(partner).inv_inertia.w, 1e-30);
-            may_wake = may_wake || manifold_of(r >> 1u).clip_face != NONE;
+            may_wake = may_wake || head.clip_face != NONE;
         }
     }
     pair_meta[i].held = held;

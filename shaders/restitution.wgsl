@@ -61,12 +61,13 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         return;
     }
     let k = pool_slot(nth, used);
-    let a = manifold_of(k).a;
-    let b = manifold_of(k).b;
+    let m = manifold_of(k); // read once (see solve_contacts)
+    let a = m.a;
+    let b = m.b;
     let ea = contact_end(a);
     let eb = contact_end(b);
-    let n = manifold_of(k).normal; // from a to b
-    let count = manifold_of(k).count;
+    let n = m.normal; // from a to b
+    let count = m.count;
     let at = point_slot(k);
     if (!ea.moves && !eb.moves) {
         for (var q = 0u; q < count; q = q + 1u) {

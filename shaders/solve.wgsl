@@ -124,16 +124,17 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let k = pool_slot(nth, used);
     // the header, read once (the pool is written here, so a second read
     // is a second load: a loop over the lanes on lavapipe)
-    let a = manifold_of(k).a;
-    let b = manifold_of(k).b;
-    let count = manifold_of(k).count;
+    let m = manifold_of(k);
+    let a = m.a;
+    let b = m.b;
+    let count = m.count;
     let at = point_slot(k);
     var ea = contact_end(a);
     var eb = contact_end(b);
     if (!ea.moves && !eb.moves) {
         return; // neither body reads its snap
     }
-    let n = manifold_of(k).normal; // from a to b: a is pushed along -n, b along n
+    let n = m.normal; // from a to b: a is pushed along -n, b along n
     // the lower body of a stacked pair counts SHOCK times its inverse mass
     // (up_n: n's component against gravity; > 0: b lies above a)
     let g = length(params.gravity);
