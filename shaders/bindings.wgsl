@@ -399,7 +399,13 @@ fn contact_end(i: u32) -> ContactEnd {
     let s = state_of(i);
     let p = props_of(i);
     let r = quat_to_mat(s.rot);
+    // a sphere's radius, read only for a sphere: where no lane holds one
+    // (a pile of boxes), lavapipe skips the load
+    var radius = 0.0;
+    if (p.shape == SHAPE_SPHERE) {
+        radius = props[i].half_extents.x;
+    }
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
-                      world_inv_inertia(r, p.inv_inertia.xyz), contact_end_moves(i),
-                      p.restitution, p.friction, select(0.0, p.half_extents.x, p.shape == SHAPE_SPHERE));
+                      world_inv_inertia(r, p.inv_inertia.xyz), !is_fixed(p) && !asleep(s),
+                      p.restitution, p.friction, radius);
 }
