@@ -386,7 +386,12 @@ fn is_jointed(i: u32) -> bool {
 // Whether the contacts may move body i: awake and not fixed (ContactEnd's
 // `moves`).
 fn contact_end_moves(i: u32) -> bool {
-    return !is_fixed(props_of(i)) && !asleep(state_of(i));
+    return moves_by_contacts(state_of(i), props_of(i));
+}
+
+// The same, from the body's state and properties already read.
+fn moves_by_contacts(s: BodyState, p: BodyProps) -> bool {
+    return !is_fixed(p) && !asleep(s);
 }
 
 fn contact_end(i: u32) -> ContactEnd {
@@ -403,9 +408,9 @@ fn contact_end(i: u32) -> ContactEnd {
     // (a pile of boxes), lavapipe skips the load
     var radius = 0.0;
     if (p.shape == SHAPE_SPHERE) {
-        radius = props[i].half_extents.x;
+        radius = props_of(i).half_extents.x;
     }
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
-                      world_inv_inertia(r, p.inv_inertia.xyz), !is_fixed(p) && !asleep(s),
+                      world_inv_inertia(r, p.inv_inertia.xyz), moves_by_contacts(s, p),
                       p.restitution, p.friction, radius);
 }
