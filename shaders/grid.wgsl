@@ -131,8 +131,9 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     sorted[params.body_count + i] = NONE; // no body listed here yet
     let reach = reach_of(i);
     let spin = spin_reach_of(i);
+    let s = state_of(i);
     let fixed = is_fixed(props_of(i));
-    let moves = !fixed && (!asleep(state_of(i)) || (state_of(i).pos_low & WAKES) != 0u);
+    let moves = !fixed && (!asleep(s) || (s.pos_low & WAKES) != 0u);
     let sleeps = !fixed && !moves;
     pair_meta[i].moves = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here

@@ -179,7 +179,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
 fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState {
     var s = s_in;
     let first = pair_meta[i].list_start;
-    let acts = !is_fixed(p) && !asleep(s);
+    let acts = moves_by_contacts(s, p);
     let end = select(first, first + pair_meta[i].contacts, acts && pending);
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
