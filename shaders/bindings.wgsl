@@ -116,14 +116,15 @@ fn set_cell_bound(k: u32, c: CellBound) {
 struct PropsWords {
     half_extents: vec4<f32>,
     inv_inertia: vec4<f32>,
-    c: vec4<f32>,   // restitution, friction, kept_inv_mass, speed_limit
-    d: vec4<u32>,   // shape, flags, grid_class, _pad1
+    c: vec4<u32>,   // restitution, friction (their bits), shape, flags
+    d: vec4<u32>,   // kept_inv_mass, speed_limit (their bits), grid_class, _pad1
 }
 
 // Body i's properties.
 fn props_of(i: u32) -> BodyProps {
     let w = props[i];
-    return BodyProps(w.half_extents, w.inv_inertia, w.c.x, w.c.y, w.c.z, w.c.w, w.d.x, w.d.y, w.d.z, w.d.w);
+    let f = bitcast<vec4<f32>>(vec4<u32>(w.c.xy, w.d.xy));
+    return BodyProps(w.half_extents, w.inv_inertia, f.x, f.y, w.c.z, w.c.w, f.z, f.w, w.d.z, w.d.w);
 }
 
 // BodyState as stored: the same bytes in four vec4s.

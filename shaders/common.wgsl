@@ -53,16 +53,19 @@ fn pack_remainder(r: vec3<f32>, x: vec3<f32>, flags: u32) -> u32 {
     return q.x | (q.y << 10u) | (q.z << 20u) | (flags & (HELD | WAKES));
 }
 
-// What rarely changes: shape, mass and material. 64 bytes.
+// What rarely changes: shape, mass and material. 64 bytes. What a contact
+// reads of a body (the contact passes' `contact_end`) lies in the second
+// and third 16 bytes: its inverse inertia and mass, then its material,
+// shape and flags.
 struct BodyProps {
     half_extents: vec4<f32>, // box: xyz half extents; sphere: radius in x; w = bounding radius
     inv_inertia: vec4<f32>,  // xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg)
     restitution: f32,
     friction: f32,
-    kept_inv_mass: f32,      // a body an input made fixed: the inverse mass to restore (1/kg); else 0
-    speed_limit: f32,        // the fastest the scene's energy can move it (m/s; see fault_of); 0: none
     shape: u32,              // SHAPE_*
     flags: u32,              // FLAG_* bits
+    kept_inv_mass: f32,      // a body an input made fixed: the inverse mass to restore (1/kg); else 0
+    speed_limit: f32,        // the fastest the scene's energy can move it (m/s; see fault_of); 0: none
     grid_class: u32,         // GRID_BODY, or LARGE_BODY: kept out of the grid (see grid.wgsl)
     _pad1: u32,
 }

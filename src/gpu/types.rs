@@ -53,15 +53,15 @@ pub struct BodyProps {
     pub inv_inertia: [f32; 4],
     pub restitution: f32,
     pub friction: f32,
+    /// `SHAPE_BOX` or `SHAPE_SPHERE`.
+    pub shape: u32,
+    /// `FLAG_*` bits.
+    pub flags: u32,
     /// A body an input made fixed: the inverse mass to restore (1/kg); else 0.
     pub kept_inv_mass: f32,
     /// The fastest the scene's energy can move the body (m/s; 0: no limit
     /// but `MAX_SPEED`); see `speed_limits` in src/world/records.rs.
     pub speed_limit: f32,
-    /// `SHAPE_BOX` or `SHAPE_SPHERE`.
-    pub shape: u32,
-    /// `FLAG_*` bits.
-    pub flags: u32,
     /// `GRID_BODY`, or `LARGE_BODY` (kept out of the broadphase grid).
     pub grid_class: u32,
     pub _pad1: u32,

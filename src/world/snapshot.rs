@@ -334,19 +334,46 @@ impl World {
         put(&self.grid.hash_size.to_le_bytes());
         put(&self.grid.speculative.to_bits().to_le_bytes());
         put(&self.large_count.to_le_bytes());
-        // the speed limits follow from the rest (and were padding before
-        // them: snapshots from then still belong)
-        let mut props: Vec<BodyProps> =
-            bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.props, self.data.props.size())?);
-        for p in &mut props {
-            p.speed_limit = 0.0;
+        let props: Vec<BodyProps> = bytemuck::pod_collect_to_vec(&self.gpu.read_buffer(&self.data.props, self.data.props.size())?);
+        for p in &props {
+            put(&hashed_props(p));
         }
-        put(bytemuck::cast_slice(&props));
         for buf in &self.data.statics {
             put(&self.gpu.read_buffer(buf, buf.size())?);
         }
         Ok(h)
     }
+}
+
+/// A body's properties as the scene hash reads them: the bytes BodyProps
+/// had before the material, shape and flags were moved together (for the
+/// contact passes, which read them in one load), so that snapshots from
+/// before still belong; the speed limit zeroed, as it follows from the rest
+/// (and was padding before it was added).
+fn hashed_props(p: &BodyProps) -> [u8; 64] {
+    let words: [u32; 16] = [
+        p.half_extents[0].to_bits(),
+        p.half_extents[1].to_bits(),
+        p.half_extents[2].to_bits(),
+        p.half_extents[3].to_bits(),
+        p.inv_inertia[0].to_bits(),
+        p.inv_inertia[1].to_bits(),
+        p.inv_inertia[2].to_bits(),
+        p.inv_inertia[3].to_bits(),
+        p.restitution.to_bits(),
+        p.friction.to_bits(),
+        p.kept_inv_mass.to_bits(),
+        0,
+        p.shape,
+        p.flags,
+        p.grid_class,
+        p._pad1,
+    ];
+    let mut bytes = [0u8; 64];
+    for (out, w) in bytes.chunks_exact_mut(4).zip(words) {
+        out.copy_from_slice(&w.to_le_bytes());
+    }
+    bytes
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
