@@ -5,7 +5,7 @@
 use crate::common::Rng;
 use crate::common::{step_until_asleep, world};
 use glam::{Quat, Vec3};
-use verlet::gpu::types::{CellBound, PairMeta, FAST_BODY, MOVES_SHIFT, SCAN_SPAN};
+use verlet::gpu::types::{CellBound, ContactManifold, PairMeta, FAST_BODY, MOVES_SHIFT, SCAN_SPAN};
 use verlet::scenes::{self, box_body, sphere_body};
 use verlet::step::{Buffer, Stage};
 use verlet::world::plan_grid;
@@ -410,4 +410,47 @@ fn restitution_returns_e_times_the_approach_speed() {
     let h = settings.dt / settings.substeps as f32;
     let v = Vec3::from(after.disp) / h;
     assert!((v.y - e * 5.0).abs() < 1e-3 && v.x.abs() < 1e-5 && v.z.abs() < 1e-5, "left at {v} m/s, expected {} up", e * 5.0);
+}
+
+/// contact_lists leaves every body's list of manifolds in pair order (the
+/// manifolds whose pair another body owns first, then the body's own, each
+/// by pair index; narrowphase.wgsl's list_order), whatever order the
+/// narrowphase's atomics listed them in: a list of up to SHORT_LIST sorted
+/// in registers, a longer one by insertion. A landed pile gives lists of
+/// one to eight; a slab resting on sixteen cubes, one of sixteen.
+#[test]
+fn contact_lists_put_each_body_s_manifolds_in_pair_order() {
+    let mut scene = scenes::pile(300, 3);
+    scene.settings.sleeping = false; // a sleeper the step leaves as it is lists nothing
+    for k in 0..16 {
+        scene.bodies.push(box_body([0.5; 3], [40.0 + (k % 4) as f32 * 1.05, 0.5, (k / 4) as f32 * 1.05]));
+    }
+    scene.bodies.push(box_body([2.2, 0.25, 2.2], [41.575, 1.24, 1.575]));
+    let slab = scene.bodies.len() - 1;
+    let Some(mut w) = world(&scene) else { return };
+    w.step(120).unwrap();
+    let stages: Vec<Stage> = w.step_plan().iter().map(|&(s, _)| s).take_while(|&s| s != Stage::Integrate).collect();
+    assert!(stages.contains(&Stage::ContactLists));
+    w.run_stages(&stages).unwrap();
+    let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
+    let lists = w.read_words(Buffer::BodyPairs).unwrap();
+    let manifolds: Vec<ContactManifold> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::Manifolds).unwrap());
+    let mut lengths = vec![0usize; 20];
+    for (i, m) in meta.iter().enumerate().take(scene.bodies.len()) {
+        let first = m.list_start as usize;
+        let list = &lists[first..first + m.contacts as usize];
+        let mut last = None;
+        for &r in list {
+            let head = &manifolds[r as usize / 2];
+            let (me, owned) = if r % 2 == 0 { (head.a, true) } else { (head.b, false) };
+            assert_eq!(me as usize, i, "body {i} lists a manifold of {} and {}", head.a, head.b);
+            let key = head.pair | if owned { 0x8000_0000 } else { 0 };
+            assert!(last < Some(key), "body {i}: {list:?} is not in pair order (key {key:#x} after {last:?})");
+            last = Some(key);
+        }
+        lengths[list.len().min(19)] += 1;
+    }
+    assert!(meta[slab].contacts >= 16, "the slab lists {} manifolds", meta[slab].contacts);
+    let short: usize = lengths[3..=8].iter().sum();
+    assert!(short >= 100, "lists of 3 to 8 manifolds: {short} ({lengths:?})");
 }
