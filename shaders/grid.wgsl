@@ -41,24 +41,27 @@ fn in_grid(i: u32) -> bool {
     return props_of(i).grid_class == GRID_BODY;
 }
 
-// How far body i may move in the coming step, all its substeps (m): its last
-// displacement, rescaled to this step, plus what gravity adds.
-fn reach_of(i: u32) -> f32 {
-    let s = state_of(i);
+// The same, from the body's properties already read.
+fn grid_body(p: BodyProps) -> bool {
+    return p.grid_class == GRID_BODY;
+}
+
+// How far a body in state s may move in the coming step, all its substeps
+// (m): its last displacement, rescaled to this step, plus what gravity adds.
+fn reach_of(s: BodyState) -> f32 {
     let steps = f32(params.substeps);
     let ratio = params.dt / params.dt_prev * steps;
     let h = params.dt * steps;
     return length(s.disp) * ratio + length(params.gravity) * h * h;
 }
 
-// How far body i's turn moves any of its points in the coming step (m), if
-// it keeps the last substep's turn: a unit quaternion's change of d moves a
-// point at r from the centre by at most 2 d r, so at most 2 d R for the
-// bounding radius R, a substep; rescaled as reach_of. (q and -q are one
+// How far a body's turn (state s, properties p) moves any of its points in
+// the coming step (m), if it keeps the last substep's turn: a unit
+// quaternion's change of d moves a point at r from the centre by at most
+// 2 d r, so at most 2 d R for the bounding radius R, a substep; rescaled as
+// reach_of. (q and -q are one
 // rotation: d is the nearer of the two.) A sphere turns into itself: 0.
-fn spin_reach_of(i: u32) -> f32 {
-    let s = state_of(i);
-    let p = props_of(i);
+fn spin_reach_of(s: BodyState, p: BodyProps) -> f32 {
     let ratio = params.dt / params.dt_prev * f32(params.substeps);
     let turned = min(length(s.rot - s.prev_rot), length(s.rot + s.prev_rot));
     return select(2.0 * turned * p.half_extents.w * ratio, 0.0, p.shape == SHAPE_SPHERE);
@@ -96,13 +99,13 @@ fn is_fast(size: f32, moves: u32) -> bool {
     return size > fast_size() && moves != SLEEPS;
 }
 
-// Half extents of body i's world box: |R| h for a box, the radius for a sphere.
-fn world_extent(i: u32) -> vec3<f32> {
-    let p = props_of(i);
+// Half extents of a body's world box (state s, properties p): |R| h for a
+// box, the radius for a sphere.
+fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(p.half_extents.x);
     }
-    let q = state_of(i).rot;
+    let q = s.rot;
     let x = quat_rotate(q, vec3<f32>(p.half_extents.x, 0.0, 0.0));
     let y = quat_rotate(q, vec3<f32>(0.0, p.half_extents.y, 0.0));
     let z = quat_rotate(q, vec3<f32>(0.0, 0.0, p.half_extents.z));
@@ -129,20 +132,22 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     sorted[params.body_count + i] = NONE; // no body listed here yet
-    let reach = reach_of(i);
-    let spin = spin_reach_of(i);
+    // the body's state and properties, read once
     let s = state_of(i);
-    let fixed = is_fixed(props_of(i));
+    let p = props_of(i);
+    let reach = reach_of(s);
+    let spin = spin_reach_of(s, p);
+    let fixed = is_fixed(p);
     let moves = !fixed && (!asleep(s) || (s.pos_low & WAKES) != 0u);
     let sleeps = !fixed && !moves;
     pair_meta[i].moves = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
     pair_meta[i].reach = reach + spin;
     pair_meta[i].spin = spin;
-    pair_meta[i].extent = world_extent(i) + vec3<f32>(reach + spin);
+    pair_meta[i].extent = world_extent(s, p) + vec3<f32>(reach + spin);
     // the bounding sphere turns into itself: only the centre's move grows it
-    pair_meta[i].bound = props_of(i).half_extents.w + reach;
-    if (!in_grid(i)) {
+    pair_meta[i].bound = p.half_extents.w + reach;
+    if (!grid_body(p)) {
         return;
     }
     // the pair walks of the bodies that move look for sleepers behind them
@@ -150,7 +155,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (sleeps && atomicLoad(&status[11]) == 0u) {
         atomicStore(&status[11], 1u);
     }
-    atomicAdd(&cell_count[bucket_of(cell_of(state_of(i).pos))], 1u);
+    atomicAdd(&cell_count[bucket_of(cell_of(s.pos))], 1u);
 }
 
 // Which prefix sum the scan passes compute (set per pipeline, see above).
