@@ -32,25 +32,26 @@ fn cell_of(p: vec3<f32>) -> vec3<i32> {
     return vec3<i32>(floor(p / params.cell_size));
 }
 
-// The bucket of cell c. The cells of each block of 8 x 8 x 8 take
-// consecutive buckets from a place that hashes the block (in Morton order
-// within it), so neighbouring cells mostly lie in neighbouring buckets and
-// the grid's order follows space: a pair walk, which visits 14 cells, then
-// finds its candidates beside those of the walker before it. Each cell of
-// a block hashed alone (as before), a million piled cubes' walks missed
-// the caches cell after cell: `pairs_count` 819 -> 462 ms a step and
-// `grid_sort` 99 -> 72 (pile-1m, 5 steps), pile-100k's 61 -> 41 ms, the
-// same pairs in the same order (the walks visit cells by offset, whatever
-// their buckets). The block's place is added, not shifted in above the
-// 9 bits: blocks' runs then overlap at random instead of sharing aligned
-// places, where a lattice of bodies 8 cells apart would fill one bucket.
+// The bucket of cell c. The cells of each block of 8 x 8 x 8 take a run of
+// 512 consecutive buckets, the run's place hashed from the block, in Morton
+// order within it, so neighbouring cells mostly lie in neighbouring buckets
+// and the grid's order follows space: a pair walk, which visits 14 cells,
+// then finds its candidates beside those of the walker before it. Each cell
+// hashed alone (as before), a million piled cubes' walks missed the caches
+// cell after cell, and 39% of a landed 10k pile's cells shared a bucket
+// with another (the hash's low bits mix small coordinates poorly; a walk
+// reads the other cells' bodies too and passes them by); here two cells
+// share one only where two blocks' runs meet (none in that pile). The
+// Morton place is XORed with bits of the block's hash, so that the cells
+// of a lattice 8 cells apart (all first in their blocks) do not share the
+// first bucket of every run.
 fn bucket_of(c: vec3<i32>) -> u32 {
     let u = bitcast<vec3<u32>>(c);
     let block = u >> vec3<u32>(3u);
     let at = u & vec3<u32>(7u);
     let morton = spread_bits3(at.x) | (spread_bits3(at.y) << 1u) | (spread_bits3(at.z) << 2u);
     let h = (block.x * 73856093u) ^ (block.y * 19349663u) ^ (block.z * 83492791u);
-    return (h + morton) & (params.hash_size - 1u);
+    return ((h << 9u) | (morton ^ (h >> 23u))) & (params.hash_size - 1u);
 }
 
 // The three low bits of v, two zero bits apart (b2 b1 b0 -> b2 0 0 b1 0 0 b0).
