@@ -60,7 +60,7 @@ fn spread_bits3(v: u32) -> u32 {
 }
 
 fn in_grid(i: u32) -> bool {
-    return props_of(i).grid_class == GRID_BODY;
+    return grid_body(props_of(i));
 }
 
 // The same, from the body's properties already read.
@@ -81,8 +81,8 @@ fn reach_of(s: BodyState) -> f32 {
 // the coming step (m), if it keeps the last substep's turn: a unit
 // quaternion's change of d moves a point at r from the centre by at most
 // 2 d r, so at most 2 d R for the bounding radius R, a substep; rescaled as
-// reach_of. (q and -q are one
-// rotation: d is the nearer of the two.) A sphere turns into itself: 0.
+// reach_of. (q and -q are one rotation: d is the nearer of the two.) A
+// sphere turns into itself: 0.
 fn spin_reach_of(s: BodyState, p: BodyProps) -> f32 {
     let ratio = params.dt / params.dt_prev * f32(params.substeps);
     let turned = min(length(s.rot - s.prev_rot), length(s.rot + s.prev_rot));

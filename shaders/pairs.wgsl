@@ -38,8 +38,9 @@
 // there but the faster bodies (`outranks`); no other walk takes a pair
 // with it. A pair is wanted when the two bodies' bounds come within the
 // margin, they are not joined, and one of them moves: not fixed and awake,
-// or asleep but woken by the last step's narrowphase (pair_meta's MOVES). Only the owner decides, alike in both
-// walks (the test reads only what these passes do not write).
+// or asleep but woken by the last step's narrowphase (pair_meta's MOVES).
+// Only the owner decides, alike in both walks (the test reads only what
+// these passes do not write).
 
 // CONTACT_MARGIN (shared with Rust, src/world.rs): the gap (m) kept as
 // contact whatever the speed.
