@@ -162,7 +162,7 @@ fn set_rest_time(i: u32, rest: f32) {
 
 // The body that invocation k of a body pass (integrate, solve,
 // restitution) works on, or NONE: the k-th body contact_lists listed this
-// step, in sorted[body_count ..] (status[16] of them; grid_count fills the
+// step, in sorted[body_count ..] (status[16] of them; pairs_count fills the
 // rest of the run with NONE, so no invocation reads the count: an atomic
 // load is a loop over the lanes on lavapipe). World::run_stages without
 // contact_lists lists every body itself. Every body is listed but a

@@ -8,10 +8,13 @@
 //   scan_sums         one workgroup: prefix sum of the block totals
 //   scan_add          buckets: add block offsets -> cell_start (the grid's
 //                     alone: pairs_write adds the pairs' own)
-//   grid_scatter      bodies:  sorted[cell_end - count--] = body
-//   grid_sort         buckets: sort each bucket's bodies by the low x side of
-//                     their bounds, then index (the pair walks stop early),
-//                     and write their bounds in that order (cell_bounds)
+//   grid_scatter      bodies:  arrivals[cell_end - count--] = body (the
+//                     arrivals: sorted's second half, which pairs_count
+//                     empties for the body list after the sort)
+//   grid_sort         bodies:  each body's place in its bucket by the low x
+//                     side of its bounds, then index, counted over the
+//                     bucket's arrivals (the pair walks stop early);
+//                     sorted[place] = body, and its bounds there (cell_bounds)
 //
 // The scatter counts each bucket back down to 0, so the counts are 0 again
 // for the next step without a pass to clear them (a new buffer is zeroed).
@@ -153,7 +156,6 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    sorted[params.body_count + i] = NONE; // no body listed here yet
     // the body's state and properties, read once
     let s = state_of(i);
     let p = props_of(i);
@@ -327,9 +329,8 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let h = bucket_of(cell_of(state_of(i).pos));
-    // from the bucket's start as the count goes down (in arrival order,
-    // which is mostly by index: grid_sort then has little to move)
-    sorted[cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
+    // from the bucket's start as the count goes down, in arrival order
+    sorted[params.body_count + cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
 }
 
 // A grid body's key in its bucket: the low x side of its world box grown
@@ -338,41 +339,39 @@ fn grid_key(i: u32) -> f32 {
     return state_of(i).pos.x - pair_meta[i].extent.x;
 }
 
-// Whether body a comes before body b in their bucket: by key, then index.
-fn sorts_before(a: u32, b: u32) -> bool {
-    let ka = grid_key(a);
-    let kb = grid_key(b);
-    return ka < kb || (ka == kb && a < b);
-}
-
-// The scatter's order within a bucket depends on thread timing; sorting each
-// bucket (by key, then index) makes every later pass see the same order
-// every run, and lets a pair walk stop at the first body of a cell whose
-// box begins beyond the walker's reach along x (see pairs.wgsl). The
-// bucket's bodies' bounds then go to cell_bounds in that order, where the
-// walks read a cell's candidates side by side (CellBound).
+// The scatter's order within a bucket depends on thread timing; placing
+// each bucket's bodies by key, then index, makes every later pass see the
+// same order every run, and lets a pair walk stop at the first body of a
+// cell whose box begins beyond the walker's reach along x (see pairs.wgsl).
+// Each body counts the bodies of its bucket that come before it (by key,
+// then index): a loop as long as its bucket. (An insertion sort of each bucket by one
+// invocation took a loop as long as the bucket's inversions, about n^2/4
+// for n bodies at one place, and lavapipe ends every loop of an invocation
+// once their trips sum to 65535 (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS),
+// silently: from 510 boxes placed inside each other their bucket stayed
+// unsorted and most of their pairs were never found.) The bucket's bodies'
+// bounds go to cell_bounds in that order, where the walks read a cell's
+// candidates side by side (CellBound).
 @compute @workgroup_size(WORKGROUP)
 fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let h = gid.x;
-    if (h >= params.hash_size) {
+    let i = gid.x;
+    if (i >= params.body_count || !in_grid(i)) {
         return;
     }
+    let pos = state_of(i).pos;
+    let extent = pair_meta[i].extent;
+    let key = pos.x - extent.x; // grid_key(i)
+    let h = bucket_of(cell_of(pos));
     let start = cell_start[h];
     let end = cell_start[h + 1u];
-    for (var k = start + 1u; k < end; k = k + 1u) {
-        let v = sorted[k];
-        var m = k;
-        while (m > start && sorts_before(v, sorted[m - 1u])) {
-            sorted[m] = sorted[m - 1u];
-            m = m - 1u;
-        }
-        sorted[m] = v;
-    }
+    var place = start;
     for (var k = start; k < end; k = k + 1u) {
-        let i = sorted[k];
-        let moves = pair_meta[i].moves;
-        let extent = pair_meta[i].extent;
-        let fast = select(0u, FAST_BODY, is_fast(box_size(extent), moves));
-        set_cell_bound(k, CellBound(state_of(i).pos, pair_meta[i].bound, extent, i | fast | (moves << MOVES_SHIFT)));
+        let j = sorted[params.body_count + k];
+        let key_j = grid_key(j);
+        place = place + u32(key_j < key || (key_j == key && j < i));
     }
+    sorted[place] = i;
+    let moves = pair_meta[i].moves;
+    let fast = select(0u, FAST_BODY, is_fast(box_size(extent), moves));
+    set_cell_bound(place, CellBound(pos, pair_meta[i].bound, extent, i | fast | (moves << MOVES_SHIFT)));
 }

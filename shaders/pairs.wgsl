@@ -319,6 +319,9 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let i = sorted[gid.x];
+    // the grid's arrivals are done with: the body list starts empty
+    // (`listed_body` in bindings.wgsl; contact_lists fills it)
+    sorted[params.body_count + gid.x] = NONE;
     writing = false;
     room_start = gid.x * scratch_room();
     walk(i);

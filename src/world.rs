@@ -979,8 +979,11 @@ impl World {
         (self.at_rest, self.skipped) = (false, false);
         self.write_params(&[self.settings.dt], self.settings.substeps as usize);
         if !stages.contains(&Stage::ContactLists) {
-            if stages.contains(&Stage::GridCount) && stages.iter().any(|s| s.over() == Over::Listed) {
-                return Err(Error::Input("run_stages: grid_count empties the list of bodies that contact_lists makes".into()));
+            let clears = [Stage::GridScatter, Stage::PairsCount];
+            if stages.iter().any(|s| clears.contains(s)) && stages.iter().any(|s| s.over() == Over::Listed) {
+                return Err(Error::Input(
+                    "run_stages: grid_scatter and pairs_count overwrite the list of bodies that contact_lists makes".into(),
+                ));
             }
             // no list made: the body passes run over every body
             let n = self.body_count;

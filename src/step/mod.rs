@@ -242,7 +242,7 @@ impl Stage {
             Stage::GridScanSums | Stage::PairsScanSums => &[Params, BlockSums, Pairs, Status],
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
-            Stage::GridSort => &[Params, StateIn, CellStart, Sorted, PairMeta],
+            Stage::GridSort => &[Params, Props, StateIn, CellStart, Sorted, PairMeta],
             Stage::PairsCount => {
                 &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs, CellBounds]
             }
@@ -272,13 +272,14 @@ impl Stage {
     pub fn writes(self) -> &'static [Buffer] {
         use Buffer::*;
         match self {
-            Stage::GridCount => &[CellCount, Sorted, Status, PairMeta],
+            Stage::GridCount => &[CellCount, Status, PairMeta],
             Stage::GridScanBlocks | Stage::PairsScanBlocks => &[CellStart, BlockSums, Status, PairMeta],
             Stage::GridScanSums | Stage::PairsScanSums => &[CellStart, BlockSums, Status, PairMeta],
             Stage::GridScanAdd => &[CellStart],
             Stage::GridScatter => &[CellCount, Sorted],
             Stage::GridSort => &[Sorted, CellBounds],
-            Stage::PairsCount | Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
+            Stage::PairsCount => &[Sorted, Pairs, PairMeta, BodyPairs],
+            Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
             Stage::Narrowphase | Stage::NarrowphaseGround => {
                 &[Manifolds, Status, PairMeta, BodyPairs, Points, Points1, Points2, Points3]
             }
@@ -335,7 +336,7 @@ impl Stage {
 
     pub fn over(self) -> Over {
         match self {
-            Stage::GridScanAdd | Stage::GridSort => Over::Buckets,
+            Stage::GridScanAdd => Over::Buckets,
             Stage::GridScanBlocks => Over::ScanBlocks,
             Stage::GridScanSums | Stage::PairsScanSums => Over::One,
             Stage::PairsScanBlocks => Over::BodyScanBlocks,

@@ -352,6 +352,42 @@ fn the_pair_list_holds_every_pair_within_reach_once_at_any_speed() {
     assert!(far >= 20, "too few pairs beyond the neighbouring cells to test the fast walks: {far}");
 }
 
+/// Boxes placed inside each other, all in one bucket of the grid: the
+/// bucket comes out in grid_key order, then index, and every pair is
+/// wanted. grid_sort counts each body's place over its bucket; before, one
+/// invocation sorted a bucket by insertion, and lavapipe ends an
+/// invocation's loops once their trips sum to 65535 (gallivm's
+/// LP_MAX_TGSI_LOOP_ITERATIONS): from about 510 bodies in one bucket the
+/// sort stopped part way, and 600 such boxes wanted 177 of their 179 700
+/// pairs.
+#[test]
+fn boxes_placed_inside_each_other_want_every_pair() {
+    let n = 600;
+    let mut rng = Rng(0x5851_f42d_4c95_7f2d);
+    let bodies =
+        (0..n).map(|_| box_body([0.5; 3], [rng.range(0.0, 0.05), 3.0 + rng.range(0.0, 0.05), rng.range(0.0, 0.05)])).collect();
+    let scene = weightless(bodies);
+    let Some(mut w) = world(&scene) else { return };
+    let stages: Vec<Stage> =
+        w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
+    w.run_stages(&stages).unwrap();
+    let cell_start = w.read_words(Buffer::CellStart).unwrap();
+    let buckets = cell_start.windows(2).filter(|c| c[1] > c[0]).count();
+    assert_eq!(buckets, 1, "the boxes lie in one bucket");
+    let sorted = w.read_words(Buffer::Sorted).unwrap();
+    let states = w.read_raw().unwrap();
+    let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
+    let key = |i: usize| states[i].pos[0] - meta[i].extent[0];
+    let mut expected: Vec<u32> = (0..n as u32).collect();
+    expected.sort_by(|&a, &b| key(a as usize).total_cmp(&key(b as usize)).then(a.cmp(&b)));
+    if let Some(k) = (0..n).find(|&k| sorted[k] != expected[k]) {
+        panic!("the bucket's order differs first at place {k} of {n}: body {}, not {}", sorted[k], expected[k]);
+    }
+    assert_cell_bounds(&w, n);
+    let report = w.contact_report().unwrap();
+    assert_eq!(report.pairs as usize, n * (n - 1) / 2, "pairs wanted");
+}
+
 #[test]
 fn integrate_carries_the_displacement_and_adds_gravity() {
     let mut body = box_body([0.5, 0.25, 0.4], [3.0, 12.0, -2.0]);
