@@ -282,16 +282,7 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (end - first <= SHORT_LIST) {
         sort_short_list(first, end - first);
     } else {
-        for (var k = first + 1u; k < end; k = k + 1u) {
-            let r = body_pairs[k];
-            let key = list_order(r);
-            var m = k;
-            while (m > first && list_order(body_pairs[m - 1u]) > key) {
-                body_pairs[m] = body_pairs[m - 1u];
-                m = m - 1u;
-            }
-            body_pairs[m] = r;
-        }
+        sort_long_list(first, end - first);
     }
     pair_meta[i].contacts = end - first;
     var held = 0u;
@@ -360,6 +351,83 @@ fn sort_short_list(first: u32, n: u32) {
             body_pairs[first + k] = refs[k];
         }
     }
+}
+
+// Sorts the `n` (more than SHORT_LIST) contact references from
+// body_pairs[first] by list_order, in place. lavapipe ends every loop of an
+// invocation (of the 8 it runs side by side) once their trips sum to 65535
+// (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS), silently, so no sort here may
+// take more. An insertion sort takes as many trips as the list has
+// inversions: few for a long list the narrowphase filled in about pair
+// order (2000 boxes on one slab), but n^2/4 in random order: 600 boxes
+// placed inside each other kept part-sorted lists, and their sums ran in
+// an order that changed from run to run. So the insertion sort stops after
+// INSERTION_TRIPS, and a heap sort (about 1.5 n log2 n trips) finishes a
+// list it left: the same order either way, the keys being unique.
+const INSERTION_TRIPS: u32 = 8192u;
+
+fn sort_long_list(first: u32, n: u32) {
+    var trips = 0u;
+    var sorted_to = 1u; // body_pairs[first ..][..sorted_to] is in order
+    for (var k = 1u; k < n; k = k + 1u) {
+        if (trips >= INSERTION_TRIPS) {
+            break;
+        }
+        let r = body_pairs[first + k];
+        let key = list_order(r);
+        var m = first + k;
+        while (m > first && list_order(body_pairs[m - 1u]) > key) {
+            body_pairs[m] = body_pairs[m - 1u];
+            m = m - 1u;
+            trips = trips + 1u;
+        }
+        body_pairs[m] = r;
+        trips = trips + 1u;
+        sorted_to = k + 1u;
+    }
+    if (sorted_to == n) {
+        return;
+    }
+    // a max-heap of the list, then its largest moved to the end n - 1 times
+    for (var t = 0u; t < n / 2u; t = t + 1u) {
+        sift_down(first, n / 2u - 1u - t, n);
+    }
+    for (var t = 1u; t < n; t = t + 1u) {
+        let last = first + n - t;
+        let r = body_pairs[first];
+        body_pairs[first] = body_pairs[last];
+        body_pairs[last] = r;
+        sift_down(first, 0u, n - t);
+    }
+}
+
+// Moves the reference at place `root` of the heap of `n` from
+// body_pairs[first] down to where its key is no less than its children's.
+fn sift_down(first: u32, root_in: u32, n: u32) {
+    var root = root_in;
+    let r = body_pairs[first + root];
+    let key = list_order(r);
+    // a heap of fewer than 2^32 entries is less than 32 levels deep
+    for (var depth = 0u; depth < 32u; depth = depth + 1u) {
+        var child = 2u * root + 1u;
+        if (child >= n) {
+            break;
+        }
+        var child_key = list_order(body_pairs[first + child]);
+        if (child + 1u < n) {
+            let right_key = list_order(body_pairs[first + child + 1u]);
+            if (right_key > child_key) {
+                child = child + 1u;
+                child_key = right_key;
+            }
+        }
+        if (child_key <= key) {
+            break;
+        }
+        body_pairs[first + root] = body_pairs[first + child];
+        root = child;
+    }
+    body_pairs[first + root] = r;
 }
 
 // Whether body i is a sleeper the step leaves as it is unless something
