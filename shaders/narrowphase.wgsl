@@ -388,16 +388,22 @@ fn sort_long_list(first: u32, n: u32) {
     if (sorted_to == n) {
         return;
     }
-    // a max-heap of the list, then its largest moved to the end n - 1 times
-    for (var t = 0u; t < n / 2u; t = t + 1u) {
-        sift_down(first, n / 2u - 1u - t, n);
-    }
-    for (var t = 1u; t < n; t = t + 1u) {
-        let last = first + n - t;
-        let r = body_pairs[first];
-        body_pairs[first] = body_pairs[last];
-        body_pairs[last] = r;
-        sift_down(first, 0u, n - t);
+    // a max-heap of the list (n / 2 sifts), then its largest moved to the
+    // end n - 1 times, each followed by a sift (one loop, one call site:
+    // one copy of sift_down in the kernel)
+    let heaped = n / 2u;
+    for (var t = 0u; t < heaped + n - 1u; t = t + 1u) {
+        var root = 0u;
+        var size = n;
+        if (t < heaped) {
+            root = heaped - 1u - t;
+        } else {
+            size = n - 1u - (t - heaped);
+            let r = body_pairs[first];
+            body_pairs[first] = body_pairs[first + size];
+            body_pairs[first + size] = r;
+        }
+        sift_down(first, root, size);
     }
 }
 
