@@ -413,6 +413,13 @@ fn close_joint(j: JointRef) {
     }
 }
 
+// The most trips an invocation's loops may take, summed (`Gpu::loop_trips`:
+// lavapipe ends them all past 65535, silently; ARCHITECTURE.md, Adding a
+// stage, 8). An island of n joints takes 2n trips to read and set its rest
+// times and 2n a sweep; World::with_gpu refuses one with no room for a
+// sweep. Unlimited elsewhere.
+override LOOP_TRIPS: u32 = 0xffffffffu;
+
 @compute @workgroup_size(WORKGROUP)
 fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.island_count) {
@@ -455,9 +462,12 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // params.joint_sweeps times forward then back, as one loop whose trip
     // count is the island's own (a loop bounded by a uniform alone makes
-    // lavapipe compile the kernel again for every dispatch)
+    // lavapipe compile the kernel again for every dispatch); where the
+    // driver ends an invocation's loops past LOOP_TRIPS trips, as many
+    // whole sweeps as fit beside the two loops above
     let n = end - first;
-    for (var t = 0u; t < 2u * n * params.joint_sweeps; t = t + 1u) {
+    let sweeps = min(params.joint_sweeps, max(LOOP_TRIPS / max(2u * n, 1u), 2u) - 1u);
+    for (var t = 0u; t < 2u * n * sweeps; t = t + 1u) {
         let r = t % (2u * n);
         close_joint(joint_refs[select(first + r, end - 1u - (r - n), r >= n)]);
     }

@@ -13,7 +13,9 @@ pub mod input;
 mod records;
 pub mod snapshot;
 
-pub use records::{body_output, body_props, initial_state, joint_gaps, joint_lists, plan_grid, scene_props, GridLayout};
+pub use records::{
+    body_output, body_props, initial_state, joint_gaps, joint_lists, plan_grid, scene_props, GridLayout, JointLists,
+};
 
 /// Steps encoded into one submission; each gets its own `Params` slot.
 const MAX_BATCH: usize = 64;
@@ -487,6 +489,7 @@ impl World {
             mapped_at_creation: false,
         });
         let joints = joint_lists(scene);
+        check_islands(&gpu, &joints, n)?;
         let joint_start = with_data("joints/start", bytemuck::cast_slice(&joints.starts));
         let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&joints.refs));
         let params = device.create_buffer(&wgpu::BufferDescriptor {
@@ -1275,6 +1278,24 @@ fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
              of one storage buffer, and the adapter binds at most {} bytes",
             std::mem::size_of::<BodyState>(),
             binding_limit(gpu)
+        )));
+    }
+    Ok(())
+}
+
+/// Whether `solve_joints` can sweep every joint island at least once: one
+/// invocation closes an island's joints in turn, and where the driver ends
+/// an invocation's loops past `Gpu::loop_trips` (lavapipe), an island of n
+/// joints takes 2n trips for its rest times and 2n a sweep.
+fn check_islands(gpu: &Gpu, joints: &JointLists, bodies: usize) -> Result<(), Error> {
+    let (Some(trips), largest) = (gpu.loop_trips(), joints.largest_island(bodies)) else { return Ok(()) };
+    let most = trips / 4;
+    if largest > most {
+        return Err(Error::Capacity(format!(
+            "joints: an island of {largest} joints (bodies joined to each other, directly or through others) is more \
+             than this adapter can close: one invocation sweeps an island's joints in turn, and {} ends an \
+             invocation's loops after 65535 trips, room for islands of at most {most} joints",
+            gpu.info.name
         )));
     }
     Ok(())

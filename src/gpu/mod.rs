@@ -209,6 +209,15 @@ impl Gpu {
         Ok(Gpu { adapter, device, queue, info, limits, errors, lost, polling: std::sync::Mutex::new(()) })
     }
 
+    /// The most loop trips one invocation may take, summed over all of its
+    /// loops, where the driver ends its loops past a limit: lavapipe
+    /// (llvmpipe) ends every loop of an invocation once their trips sum to
+    /// 65535 (gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`), silently; this
+    /// leaves a margin below it. `None` where no such limit is known.
+    pub fn loop_trips(&self) -> Option<u32> {
+        self.info.name.contains("llvmpipe").then_some(65_000)
+    }
+
     /// One line naming the adapter, its backend and driver.
     pub fn describe(&self) -> String {
         let i = &self.info;

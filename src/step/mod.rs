@@ -395,7 +395,8 @@ fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// Compiles one pass with its layout (the override constants: POOL_SPLIT,
-/// DISPATCH_ROW from the device's limits, SCAN_PAIRS for the pairs' scan).
+/// DISPATCH_ROW from the device's limits, SCAN_PAIRS for the pairs' scan,
+/// LOOP_TRIPS for solve_joints where the driver limits loops).
 fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: bool) -> wgpu::ComputePipeline {
     let mut constants = vec![
         ("POOL_SPLIT", f64::from(u8::from(pool_split))),
@@ -403,6 +404,9 @@ fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: 
     ];
     if stage.scans_pairs() {
         constants.push(("SCAN_PAIRS", 1.0));
+    }
+    if let (Stage::SolveJoints, Some(trips)) = (stage, gpu.loop_trips()) {
+        constants.push(("LOOP_TRIPS", f64::from(trips)));
     }
     let mut one = gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), &constants);
     one.remove(0)

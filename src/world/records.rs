@@ -109,6 +109,14 @@ pub struct JointLists {
     pub islands: u32,
 }
 
+impl JointLists {
+    /// The most joints one island holds (0 without joints), of a scene of
+    /// `bodies` bodies.
+    pub fn largest_island(&self, bodies: usize) -> u32 {
+        self.starts[bodies + 1..].windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0)
+    }
+}
+
 pub fn joint_lists(scene: &Scene) -> JointLists {
     let n = scene.bodies.len();
     let movable = |b: i32| b >= 0 && !scene.bodies[b as usize].fixed;

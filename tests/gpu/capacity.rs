@@ -24,6 +24,36 @@ fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
     gpu.check().unwrap();
 }
 
+/// Where the driver ends an invocation's loops past a number of trips
+/// (lavapipe: 65535, summed over all of its loops), `solve_joints`, which
+/// sweeps an island's joints in one invocation, has room for islands of
+/// `loop_trips / 4` joints (2n trips for the rest times, 2n a sweep): a
+/// chain one link longer is refused, naming its joints; a chain at the
+/// limit steps, and one sweep a pass keeps its links joined. Elsewhere
+/// there is no such limit.
+#[test]
+fn a_joint_island_too_large_for_the_drivers_loops_is_refused() {
+    let Some(gpu) = crate::common::gpu() else { return };
+    let Some(trips) = gpu.loop_trips() else {
+        eprintln!("{}: no loop limit known", gpu.describe());
+        return;
+    };
+    let most = (trips / 4) as usize;
+    match World::with_gpu(gpu.clone(), &scenes::chain(most + 1)) {
+        Err(Error::Capacity(why)) => {
+            assert!(why.contains(&format!("island of {} joints", most + 1)), "the reason names the island: {why}");
+        }
+        Err(other) => panic!("refused for the wrong reason: {other}"),
+        Ok(_) => panic!("an island of {} joints was accepted; at most {most} fit", most + 1),
+    }
+    let scene = scenes::chain(most);
+    let mut w = World::with_gpu(gpu.clone(), &scene).unwrap();
+    w.step(3).unwrap();
+    let gaps = verlet::world::joint_gaps(&scene, &w.read_raw().unwrap());
+    let widest = gaps.iter().cloned().fold(0.0f32, f32::max);
+    assert!(widest < 0.01, "a chain of {most} links opened {widest} m");
+}
+
 #[test]
 fn the_pair_pools_grow_for_a_crowded_scene() {
     // 13 x 13 x 13 balls: about 10 owned pairs a body, more than the list
