@@ -353,6 +353,24 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
         inputs.push(("the --input track", track));
     }
     output::check_distinct(&inputs, &outputs)?;
+    // a failed run keeps the trace's rows beside it: that name must be no
+    // input or output either (an existing file there is never replaced: see
+    // `Recorder::abandon`)
+    if let Some(trace) = &args.trace {
+        let partial = partial_path(trace);
+        if let Some((input, _)) = inputs.iter().find(|(_, p)| output::same_file(&partial, p)) {
+            return Err(Error::Input(format!(
+                "--trace: a failed run keeps its rows in {}, which is {input}, an input; give --trace another path",
+                partial.display()
+            )));
+        }
+        if let Some((other, _)) = outputs.iter().find(|(_, p)| output::same_file(&partial, p)) {
+            return Err(Error::Input(format!(
+                "--trace: a failed run keeps its rows in {}, which is {other}'s output; give each its own path",
+                partial.display()
+            )));
+        }
+    }
     for (flag, path) in files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))) {
         output::check_output(flag, path)?;
     }
@@ -362,6 +380,14 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// Where a failed run keeps the trace's rows: `TRACE.partial` (or, when a
+/// file is there, `TRACE.partial.1`, ...: `AtomicFile::keep_beside`).
+fn partial_path(trace: &Path) -> PathBuf {
+    let mut partial = trace.as_os_str().to_os_string();
+    partial.push(".partial");
+    PathBuf::from(partial)
 }
 
 fn run(args: RunArgs) -> Result<(), Error> {
@@ -686,20 +712,22 @@ impl Recorder {
     }
 
     /// After a failed run: keeps the trace rows recorded so far beside the
-    /// trace's path (`PATH.partial`), never at it, and says on stderr what
-    /// was kept and what was not written.
+    /// trace's path (`PATH.partial`, or `PATH.partial.1`, ... when a file is
+    /// there: none is replaced), never at it, and says on stderr what was
+    /// kept and what was not written.
     fn abandon(self, args: &RunArgs) {
         let upto = match self.last_step {
             Some(step) => format!("steps 0 to {step}"),
             None => "no step".to_string(),
         };
         if let Some((path, file)) = self.trace {
-            let mut partial = path.clone().into_os_string();
-            partial.push(".partial");
-            let partial = PathBuf::from(partial);
+            let partial = partial_path(&path);
             let kept = match self.last_step {
-                Some(_) => match file.keep_as(&partial) {
-                    Ok(()) => format!("its rows of {upto} are in {}", partial.display()),
+                Some(_) => match file.keep_beside(&partial) {
+                    Ok(kept) if kept == partial => format!("its rows of {upto} are in {}", kept.display()),
+                    Ok(kept) => {
+                        format!("its rows of {upto} are in {} ({} was there already, and stays)", kept.display(), partial.display())
+                    }
                     Err(e) => format!("its rows could not be kept: {e}"),
                 },
                 None => "no rows were recorded".to_string(),

@@ -86,10 +86,23 @@ impl AtomicFile {
         self.finish_as(&dest)
     }
 
-    /// Flushes what was written and renames it to `other` instead (a run's
-    /// partial output, kept apart from the destination).
-    pub fn keep_as(mut self, other: &Path) -> Result<(), Error> {
-        self.finish_as(other)
+    /// Flushes what was written and keeps it under `first`, or when a file
+    /// (or anything) is there, under the first of `first.1`, `first.2`, ...
+    /// that is free (a run's partial output, kept apart from the
+    /// destination). Never replaces a file: the name is taken by a hard link
+    /// (or, where the file system has none, a file created new), both of
+    /// which fail on an existing name. Returns the path kept.
+    pub fn keep_beside(mut self, first: &Path) -> Result<PathBuf, Error> {
+        let writer = self.writer.take().expect("finished once");
+        let kept = match writer.into_inner() {
+            Ok(file) => {
+                drop(file);
+                keep_new(&self.temp, first)
+            }
+            Err(e) => Err(io_err(&self.dest, e.into_error())),
+        };
+        let _ = std::fs::remove_file(&self.temp);
+        kept
     }
 
     fn finish_as(&mut self, path: &Path) -> Result<(), Error> {
@@ -98,6 +111,45 @@ impl AtomicFile {
         drop(file);
         std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
     }
+}
+
+/// The most numbered names [`AtomicFile::keep_beside`] tries.
+const KEEP_TRIES: usize = 1000;
+
+/// Gives `temp`'s bytes the first free name of `first`, `first.1`, ...;
+/// `temp` itself stays (the caller removes it).
+fn keep_new(temp: &Path, first: &Path) -> Result<PathBuf, Error> {
+    for k in 0..KEEP_TRIES {
+        let path = if k == 0 {
+            first.to_path_buf()
+        } else {
+            let mut name = first.as_os_str().to_os_string();
+            name.push(format!(".{k}"));
+            PathBuf::from(name)
+        };
+        match std::fs::hard_link(temp, &path) {
+            Ok(()) => return Ok(path),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            // no hard links here (or across devices): copy into a file made new
+            Err(_) => match std::fs::OpenOptions::new().write(true).create_new(true).open(&path) {
+                Ok(mut out) => {
+                    let copied =
+                        File::open(temp).and_then(|mut from| std::io::copy(&mut from, &mut out)).and_then(|_| out.sync_all());
+                    return match copied {
+                        Ok(()) => Ok(path),
+                        Err(source) => {
+                            // the file is this run's own: no half copy stays
+                            let _ = std::fs::remove_file(&path);
+                            Err(io_err(&path, source))
+                        }
+                    };
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(source) => return Err(io_err(&path, source)),
+            },
+        }
+    }
+    Err(Error::Input(format!("{} and {} more numbered names beside it are all taken", first.display(), KEEP_TRIES - 1)))
 }
 
 impl Drop for AtomicFile {

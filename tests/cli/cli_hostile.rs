@@ -236,15 +236,20 @@ fn unusable_output_paths_are_refused_before_the_first_step() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
-    let (dir, _, _) = workdir("failed");
-    // body 1 of a row flies off at 2e5 m/s: the numerical fault stops the run
+/// A scene whose run fails a few steps in: body 1 of a row flies off at
+/// 2e5 m/s, and the numerical fault stops the run.
+fn flying_scene() -> String {
     let mut scene = scenes::stack(0);
     scene.bodies = (0..3).map(|k| scenes::box_body([0.5; 3], [10.0 * k as f32, 0.5, 0.0])).collect();
     scene.bodies[1].linear_velocity = [0.0, 0.0, 2e5];
+    scene.to_json()
+}
+
+#[test]
+fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
+    let (dir, _, _) = workdir("failed");
     let bad = dir.join("bad.json");
-    std::fs::write(&bad, scene.to_json()).unwrap();
+    std::fs::write(&bad, flying_scene()).unwrap();
     let (trace, state, frames) = (dir.join("trace.csv"), dir.join("state.json"), dir.join("frames"));
     std::fs::write(&trace, "an old trace\n").unwrap();
     std::fs::write(&state, "an old state\n").unwrap();
@@ -282,6 +287,53 @@ fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
     // no half-written or temporary file anywhere
     assert_eq!(listing(&dir), ["bad.json", "frames", "scene.json", "state.json", "trace.csv", "trace.csv.partial"]);
     assert_eq!(listing(&frames), ["frame_000000.png"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_partial_trace_of_a_failed_run_replaces_no_file() {
+    let (dir, _, _) = workdir("partial");
+    // the scene, or another output, where the partial rows would go: refused before anything runs
+    let scene = dir.join("t.csv.partial");
+    let text = flying_scene();
+    std::fs::write(&scene, &text).unwrap();
+    let (sc, trace) = (s(&scene), dir.join("t.csv"));
+    let other = dir.join("o.csv");
+    let other_partial = format!("{}.partial", s(&other));
+    for (args, wanted) in [
+        (vec!["run", sc, "--steps", "30", "--trace", s(&trace)], vec!["--trace", sc, "scene file"]),
+        (
+            vec!["run", "--builtin", "drop", "--steps", "30", "--trace", s(&other), "--state-out", &other_partial],
+            vec!["--trace", &other_partial, "--state-out"],
+        ),
+        (
+            vec!["run", "--builtin", "drop", "--steps", "30", "--trace", s(&other), "--frames", &other_partial],
+            vec!["--trace", "--frames"],
+        ),
+    ] {
+        let (out, _) = capped(&args);
+        assert_refused(&args, &out, &wanted);
+        assert_eq!(std::fs::read_to_string(&scene).unwrap(), text, "{args:?}: the scene changed");
+        assert_eq!(listing(&dir), ["scene.json", "t.csv.partial"], "{args:?}: files were made");
+    }
+    // a user's file there stays; the rows go to the next free name
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, &text).unwrap();
+    let mine = dir.join("u.csv.partial");
+    std::fs::write(&mine, "USERDATA\n").unwrap();
+    let trace = dir.join("u.csv");
+    let args = ["run", s(&bad), "--steps", "30", "--trace", s(&trace)];
+    let (out, _) = capped(&args);
+    if no_adapter(&out) {
+        return;
+    }
+    assert_refused(&args, &out, &["body 1 became absurd"]);
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "USERDATA\n", "the user's file was replaced");
+    let kept = dir.join("u.csv.partial.1");
+    let rows = std::fs::read_to_string(&kept).expect("the rows go to the next free name");
+    assert!(rows.starts_with(verlet::output::TRACE_HEADER), "{rows}");
+    assert!(stderr(&out).contains(s(&kept)), "{}", stderr(&out));
+    assert_eq!(listing(&dir), ["bad.json", "scene.json", "t.csv.partial", "u.csv.partial", "u.csv.partial.1"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
