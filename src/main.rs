@@ -378,6 +378,8 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
         if dir.exists() && !dir.is_dir() {
             return Err(Error::Input(format!("--frames: cannot create directory {}: a file is there", dir.display())));
         }
+        let others: Vec<(&str, &Path)> = outputs.iter().copied().filter(|(flag, _)| *flag != "--frames").collect();
+        output::check_frames_dir(dir, &inputs, &others)?;
     }
     Ok(())
 }
@@ -679,7 +681,7 @@ impl Recorder {
         if let Some(renderer) = self.renderer.as_mut() {
             let image = renderer.render(world)?;
             if let Some(dir) = &self.frames_dir {
-                let path = dir.join(format!("frame_{:06}.png", self.frames_written));
+                let path = dir.join(output::frame_name(self.frames_written));
                 render::write_png(&image, &path).map_err(|e| Error::Input(format!("--frames: {e}")))?;
             }
             self.frames_written += 1;

@@ -218,6 +218,57 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     resolve(a) == resolve(b)
 }
 
+/// The name of the `k`-th PNG frame that `--frames DIR` writes into DIR.
+pub fn frame_name(k: u64) -> String {
+    format!("frame_{k:06}.png")
+}
+
+/// Whether a frame written by `--frames` may take this name
+/// (`frame_` then six or more digits, `.png`; see [`frame_name`]).
+pub fn is_frame_name(name: &std::ffi::OsStr) -> bool {
+    let name = name.as_encoded_bytes();
+    let digits = name.strip_prefix(b"frame_").and_then(|rest| rest.strip_suffix(b".png"));
+    digits.is_some_and(|d| d.len() >= 6 && d.iter().all(u8::is_ascii_digit))
+}
+
+/// Refuses, for `--frames DIR`, an input or another output that a frame
+/// would replace: a file in DIR under a frame's name (compared as files,
+/// through links), or a frame-named link in DIR to one.
+pub fn check_frames_dir(dir: &Path, inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Result<(), Error> {
+    let named = |path: &Path| {
+        inputs
+            .iter()
+            .find(|(_, p)| same_file(path, p))
+            .map(|(input, _)| format!("{input}, an input"))
+            .or_else(|| outputs.iter().find(|(_, p)| same_file(path, p)).map(|(flag, _)| format!("{flag}'s output")))
+    };
+    let refuse = |path: &Path, what: String| {
+        Err(Error::Input(format!(
+            "--frames: a frame written into {} would overwrite {}, which is {what}; give another directory",
+            dir.display(),
+            path.display()
+        )))
+    };
+    for (_, path) in inputs.iter().chain(outputs) {
+        let real = resolve(path);
+        let in_dir = real.parent().is_some_and(|p| same_file(p, dir));
+        if in_dir && real.file_name().is_some_and(is_frame_name) {
+            return refuse(path, named(path).unwrap_or_default());
+        }
+    }
+    // a frame-named link in DIR to a file elsewhere: the frame would be written through it
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for entry in entries.flatten() {
+            if is_frame_name(&entry.file_name()) {
+                if let Some(what) = named(&entry.path()) {
+                    return refuse(&entry.path(), what);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Refuses an output that names an input, or the same file as another
 /// output: `(flag, path)` pairs, the flag as the user gave it (a scene
 /// file given without a flag is named "the scene").

@@ -338,6 +338,49 @@ fn the_partial_trace_of_a_failed_run_replaces_no_file() {
 }
 
 #[test]
+fn frames_would_overwrite_no_input_or_output() {
+    let (dir, _, text) = workdir("frames-clash");
+    let frame_scene = dir.join("frame_000001.png");
+    std::fs::write(&frame_scene, &text).unwrap();
+    let (d, fs) = (s(&dir), s(&frame_scene));
+    let (gif, state) = (format!("{d}/frame_000002.png"), format!("{d}/frame_000003.png"));
+    let small = ["--width", "8", "--height", "8"];
+    for (args, wanted) in [
+        (vec!["run", fs, "--steps", "2", "--frames", d], vec!["--frames", fs, "scene file"]),
+        (vec!["run", "--builtin", "drop", "--steps", "2", "--frames", d, "--gif", &gif], vec!["--frames", &gif, "--gif"]),
+        (vec!["run", "--builtin", "drop", "--steps", "2", "--frames", d, "--state-out", &state], vec!["--frames", "--state-out"]),
+    ] {
+        let args: Vec<&str> = args.into_iter().chain(small).collect();
+        let (out, _) = capped(&args);
+        assert_refused(&args, &out, &wanted);
+        assert_eq!(std::fs::read(&frame_scene).unwrap(), text, "{args:?}: the scene changed");
+        assert_eq!(listing(&dir), ["frame_000001.png", "scene.json"], "{args:?}: files were made");
+    }
+    // a frame-named link in the directory to an input elsewhere: the frame would go through it
+    #[cfg(unix)]
+    {
+        let (other, scene, _) = workdir("frames-link");
+        std::os::unix::fs::symlink(&scene, other.join("frame_000000.png")).unwrap();
+        let args = ["run", s(&scene), "--steps", "2", "--frames", s(&other), "--width", "8", "--height", "8"];
+        let (out, _) = capped(&args);
+        assert_refused(&args, &out, &["--frames", "frame_000000.png", "scene file"]);
+        assert_eq!(std::fs::read(&scene).unwrap(), text);
+        let _ = std::fs::remove_dir_all(&other);
+    }
+    // the scene in the frames directory under another name is no clash
+    let scene = dir.join("scene.json");
+    std::fs::remove_file(&frame_scene).unwrap();
+    let (out, _) = capped(&["run", s(&scene), "--steps", "2", "--frames", d, "--width", "8", "--height", "8"]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read(&scene).unwrap(), text);
+    assert_eq!(listing(&dir), ["frame_000000.png", "frame_000001.png", "frame_000002.png", "scene.json"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_good_run_replaces_old_outputs_whole() {
     let (dir, scene, original) = workdir("good");
     let (trace, state) = (dir.join("trace.csv"), dir.join("state.json"));
