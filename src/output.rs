@@ -99,17 +99,28 @@ impl AtomicFile {
                 drop(file);
                 keep_new(&self.temp, first)
             }
-            Err(e) => Err(io_err(&self.dest, e.into_error())),
+            // the bytes were on their way to `first`, not to the destination
+            Err(e) => Err(io_err(first, e.into_error())),
         };
         let _ = std::fs::remove_file(&self.temp);
         kept
     }
 
+    /// Flushes and renames; on any failure (a full disk shows first at the
+    /// flush) the temporary file is removed, so none stays behind.
     fn finish_as(&mut self, path: &Path) -> Result<(), Error> {
         let writer = self.writer.take().expect("finished once");
-        let file = writer.into_inner().map_err(|e| io_err(&self.dest, e.into_error()))?;
-        drop(file);
-        std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
+        let done = match writer.into_inner() {
+            Ok(file) => {
+                drop(file);
+                std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
+            }
+            Err(e) => Err(io_err(&self.dest, e.into_error())),
+        };
+        if done.is_err() {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+        done
     }
 }
 
@@ -288,4 +299,70 @@ pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Re
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh empty directory under the temp dir.
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("verlet-output-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> =
+            std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_failed_commit_or_keep_leaves_no_temporary_file() {
+        let dir = scratch("failed-commit");
+        // the destination turns into a directory with a file in it: the rename fails
+        let dest = dir.join("out.csv");
+        let mut file = AtomicFile::create(&dest).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        std::fs::create_dir(&dest).unwrap();
+        std::fs::write(dest.join("inside"), b"x").unwrap();
+        assert!(file.commit().is_err());
+        assert_eq!(listing(&dir), ["out.csv"]);
+        // no directory for the kept rows: the keep fails, naming where they were to go
+        let dest = dir.join("t.csv");
+        let mut file = AtomicFile::create(&dest).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        let nowhere = dir.join("no").join("t.csv.partial");
+        let err = file.keep_beside(&nowhere).unwrap_err().to_string();
+        assert!(err.contains("t.csv.partial"), "{err}");
+        assert_eq!(listing(&dir), ["out.csv"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn kept_rows_take_the_first_free_name() {
+        let dir = scratch("keep");
+        let first = dir.join("t.csv.partial");
+        std::fs::write(&first, b"mine").unwrap();
+        std::fs::write(dir.join("t.csv.partial.1"), b"mine too").unwrap();
+        let mut file = AtomicFile::create(&dir.join("t.csv")).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        assert_eq!(file.keep_beside(&first).unwrap(), dir.join("t.csv.partial.2"));
+        assert_eq!(std::fs::read(&first).unwrap(), b"mine");
+        assert_eq!(std::fs::read(dir.join("t.csv.partial.2")).unwrap(), b"rows\n");
+        assert_eq!(listing(&dir), ["t.csv.partial", "t.csv.partial.1", "t.csv.partial.2"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn frame_names_are_recognised() {
+        assert!(is_frame_name(frame_name(0).as_ref()));
+        assert!(is_frame_name(frame_name(12_345_678).as_ref()));
+        for name in ["frame_1.png", "frame_000001.PNG", "frame_00000a.png", "xframe_000001.png", "frame_000001.png.tmp"] {
+            assert!(!is_frame_name(name.as_ref()), "{name}");
+        }
+    }
 }
