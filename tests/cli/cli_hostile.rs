@@ -594,6 +594,72 @@ fn track_events_after_the_last_step_are_warned_of() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Runs `verlet args` under the 4 GB cap with stdout going to `stdout`.
+fn capped_to(args: &[&str], stdout: std::process::Stdio) -> std::process::Child {
+    Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 4000000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_verlet"))
+        .args(args)
+        .stdout(stdout)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("sh runs verlet")
+}
+
+#[test]
+fn a_closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
+    // the reader goes before the scene (3 MB, more than a pipe holds) is written
+    let mut child = capped_to(&["scene", "cubes", "--count", "10000"], std::process::Stdio::piped());
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(141), "128 + SIGPIPE, as a shell reports `yes | head`: {}", stderr(&out));
+    assert_eq!(stderr(&out), "", "a closed pipe is no error to report");
+    #[cfg(target_os = "linux")]
+    for args in [&["scene", "cubes", "--count", "3"][..], &["info"], &["run", "--builtin", "drop", "--steps", "2"]] {
+        let full = std::fs::File::create("/dev/full").unwrap();
+        let out = capped_to(args, full.into()).wait_with_output().unwrap();
+        if no_adapter(&out) {
+            continue;
+        }
+        assert_refused(args, &out, &["stdout", "No space left"]);
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn bench_takes_an_output_path_that_is_not_utf8() {
+    use std::os::unix::ffi::OsStrExt;
+    let (dir, _, _) = workdir("bench-bytes");
+    let json = dir.join(std::ffi::OsStr::from_bytes(b"x\xff.json"));
+    let out = Command::new(env!("CARGO_BIN_EXE_verlet"))
+        .args([
+            "bench",
+            "--no-peer",
+            "--cases",
+            "cubes:10",
+            "--steps",
+            "2",
+            "--reps",
+            "1",
+            "--profile-steps",
+            "0",
+            "--settle-steps",
+            "0",
+        ])
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert!(report["command"].as_str().unwrap().contains("x\u{fffd}.json"), "{}", report["command"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 // ---------------------------------------------------------------------------
 // 5. A quiet doorstep (issue 15)
 // ---------------------------------------------------------------------------
