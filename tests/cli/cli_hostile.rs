@@ -549,6 +549,28 @@ fn malformed_scene_files_are_named_with_the_line() {
 }
 
 #[test]
+fn endless_or_huge_files_are_refused_without_reading_them_whole() {
+    let (dir, _, _) = workdir("endless");
+    // a NUL byte is no JSON: /dev/zero fails at its first byte, not at the OOM killer
+    for args in [&["run", "/dev/zero", "--steps", "1"][..], &["run", "--builtin", "drop", "--steps", "1", "--input", "/dev/zero"]] {
+        let (out, _) = capped(args);
+        assert_refused(args, &out, &["/dev/zero", "line 1, column 1", "NUL byte"]);
+    }
+    let nul = dir.join("nul.json");
+    std::fs::write(&nul, b"{\n  \"bodies\": [\0").unwrap();
+    let args = ["run", s(&nul), "--steps", "1"];
+    let (out, _) = capped(&args);
+    assert_refused(&args, &out, &[s(&nul), "line 2, column 14", "NUL byte"]);
+    // a file over the cap (sparse: it takes no disk) is refused by its size, naming it
+    let huge = dir.join("huge.json");
+    std::fs::File::create(&huge).unwrap().set_len(verlet::load_error::MAX_FILE_BYTES + 1).unwrap();
+    let args = ["run", s(&huge), "--steps", "1"];
+    let (out, _) = capped(&args);
+    assert_refused(&args, &out, &[s(&huge), "scene file", &verlet::load_error::MAX_FILE_BYTES.to_string()]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_scene_given_as_a_track_is_called_a_scene() {
     let (dir, scene, original) = workdir("scene-as-track");
     assert_refused_quickly(&["run", "--builtin", "drop", "--steps", "1", "--input", s(&scene)], &["--input", "scene"]);
