@@ -451,7 +451,9 @@ macro_rules! progress {
     ($($t:tt)*) => {{ eprintln!($($t)*); }};
 }
 
-/// Runs the benchmark and prints the report; writes `--json` and `--csv`.
+/// Runs the benchmark; writes `--json` and `--csv`. The caller prints the
+/// report (`table`) once every file is written, so a closed stdout costs
+/// no file.
 pub fn run(opts: &Options) -> Result<Report, Error> {
     let steps = opts.steps.unwrap_or(if opts.quick { QUICK_STEPS } else { DEFAULT_STEPS });
     let reps = opts.reps.unwrap_or(if opts.quick { QUICK_REPS } else { DEFAULT_REPS });
@@ -552,7 +554,6 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
         cases: results,
     };
     let report = Report { targets: targets(&report), ..report };
-    print!("{}", table(&report));
     if let Some(path) = &opts.json {
         let text = serde_json::to_string_pretty(&report).expect("the report serialises");
         verlet::output::write_file(path, &text)?;

@@ -7,6 +7,12 @@ use std::path::PathBuf;
 
 use crate::scene::{classify_json_error, one_line, text_problem, JsonFault};
 
+/// The most bytes a scene or track file may hold: 1 KiB for each of the
+/// most bodies any world holds (`scenes::MAX_BODIES`); a scene as
+/// `verlet scene` writes it takes about 340 bytes a body, a chain link with
+/// its joint about 380. 1 GiB: a bound on memory, not a format limit.
+pub const MAX_FILE_BYTES: u64 = 1024 * crate::scenes::MAX_BODIES;
+
 /// Which kind of file an error is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FileKind {
@@ -94,9 +100,50 @@ impl LoadError {
         LoadError::invalid(field, "is required but missing")
     }
 
-    /// The text of a file of kind `file`, or why it cannot be read.
+    /// The text of a file of kind `file`, or why it cannot be read. Read
+    /// in chunks so that garbage fails fast: a NUL byte (no JSON text holds
+    /// one; `/dev/zero`) is refused with its line and column where it is
+    /// met, and a file over [`MAX_FILE_BYTES`] as soon as that shows,
+    /// before it takes the machine's memory.
     pub(crate) fn read(file: FileKind, path: &std::path::Path) -> Result<String, LoadError> {
-        std::fs::read_to_string(path).map_err(|error| LoadError::Io { file, path: path.to_path_buf(), error })
+        use std::io::Read;
+        let io = |error| LoadError::Io { file, path: path.to_path_buf(), error };
+        let too_large = || {
+            io(std::io::Error::other(format!(
+                "it is larger than {MAX_FILE_BYTES} bytes, more than a {} for the most bodies a world holds ({}) needs",
+                file.noun(),
+                crate::scenes::MAX_BODIES
+            )))
+        };
+        let mut from = std::fs::File::open(path).map_err(io)?;
+        if from.metadata().is_ok_and(|m| m.is_file() && m.len() > MAX_FILE_BYTES) {
+            return Err(too_large());
+        }
+        let mut bytes = Vec::new();
+        let mut chunk = vec![0u8; 1 << 16];
+        loop {
+            let n = match from.read(&mut chunk) {
+                Ok(0) => break,
+                Ok(n) => n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(io(e)),
+            };
+            if let Some(k) = chunk[..n].iter().position(|&b| b == 0) {
+                bytes.extend_from_slice(&chunk[..k]);
+                let start = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+                let line = bytes.iter().filter(|&&b| b == b'\n').count() + 1;
+                let column = String::from_utf8_lossy(&bytes[start..]).chars().count() + 1;
+                let message = "a NUL byte (0x00), which no JSON text holds: this is not a text file".to_string();
+                return Err(LoadError::Syntax { file, line, column, message });
+            }
+            if (bytes.len() + n) as u64 > MAX_FILE_BYTES {
+                return Err(too_large());
+            }
+            bytes.extend_from_slice(&chunk[..n]);
+        }
+        // as std::fs::read_to_string says it
+        String::from_utf8(bytes)
+            .map_err(|_| io(std::io::Error::new(std::io::ErrorKind::InvalidData, "stream did not contain valid UTF-8")))
     }
 
     /// Refuses text that is no JSON before parsing it (empty, a byte order

@@ -13,8 +13,39 @@ use verlet::render::{self, Renderer};
 use verlet::track::Track;
 use verlet::{gpu::Gpu, output, scenes, Error, Scene, World};
 
+/// `print!` that returns an error (`stdout_error`) instead of panicking
+/// when stdout is closed or full; `main` ends quietly on a closed pipe.
+macro_rules! out {
+    ($($t:tt)*) => {
+        std::io::Write::write_fmt(&mut std::io::stdout(), format_args!($($t)*)).map_err($crate::stdout_error)
+    };
+}
+
+/// `println!` as [`out!`] is `print!`.
+macro_rules! outln {
+    ($($t:tt)*) => {
+        out!("{}\n", format_args!($($t)*))
+    };
+}
+
 mod harness;
 mod plot;
+
+/// What a failed write to stdout becomes: an error naming stdout, or for
+/// a reader that closed the pipe, the quiet end `main` gives it.
+fn stdout_error(source: std::io::Error) -> Error {
+    Error::Io { path: "stdout".into(), source }
+}
+
+/// Whether `e` is stdout's reader having gone (`verlet scene ... | head`).
+fn is_closed_pipe(e: &Error) -> bool {
+    matches!(e, Error::Io { path, source } if path == "stdout" && source.kind() == std::io::ErrorKind::BrokenPipe)
+}
+
+/// The exit status after stdout's reader went: 128 + SIGPIPE, as a shell
+/// reports a tool that SIGPIPE ended (`yes | head`), so `set -o pipefail`
+/// scripts see what they see of any other tool.
+const CLOSED_PIPE_EXIT: u8 = 141;
 
 #[derive(Parser)]
 #[command(name = "verlet", version, about = "GPU rigid-body simulator (quaternion position-Verlet, Kenwright)")]
@@ -200,8 +231,11 @@ fn main() -> ExitCode {
         Command::Info => info(),
         Command::Bench(a) => bench(a),
     };
+    // what stdout still holds goes out now, so that a full disk is reported
+    let result = result.and_then(|()| std::io::stdout().flush().map_err(stdout_error));
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if is_closed_pipe(&e) => ExitCode::from(CLOSED_PIPE_EXIT),
         Err(e) => {
             eprintln!("error: {}", e.to_string().replace('\n', " "));
             ExitCode::FAILURE
@@ -241,7 +275,7 @@ fn bench(a: BenchArgs) -> Result<(), verlet::Error> {
         rapier_sleeping: a.rapier_sleeping,
         settle_steps: a.settle_steps,
         rapier_iterations: a.rapier_iterations,
-        command: std::env::args().collect::<Vec<_>>().join(" "),
+        command: std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect::<Vec<_>>().join(" "),
     })?;
     if let Some(path) = &a.plot {
         let title = format!("{} on {} ({} cores)", report.adapter, report.cpu, report.cores);
@@ -250,7 +284,7 @@ fn bench(a: BenchArgs) -> Result<(), verlet::Error> {
         verlet::output::write_file(path, &chart)?;
         eprintln!("wrote {}", path.display());
     }
-    Ok(())
+    out!("{}", harness::table(&report))
 }
 
 /// One line for a command-line error: clap's first line, or for a value
@@ -304,7 +338,7 @@ fn print_scene(name: &str, count: Option<usize>, seed: u64) -> Result<(), Error>
     // bounded before it is built: any adapter's limit (`verlet run` checks this one's)
     let scene = scenes::checked(name, count, seed, scenes::MAX_BODIES)?;
     warn_unused_count(name, count);
-    println!("{}", scene.to_json());
+    outln!("{}", scene.to_json())?;
     Ok(())
 }
 
@@ -353,6 +387,24 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
         inputs.push(("the --input track", track));
     }
     output::check_distinct(&inputs, &outputs)?;
+    // a failed run keeps the trace's rows beside it: that name must be no
+    // input or output either (an existing file there is never replaced: see
+    // `Recorder::abandon`)
+    if let Some(trace) = &args.trace {
+        let partial = partial_path(trace);
+        if let Some((input, _)) = inputs.iter().find(|(_, p)| output::same_file(&partial, p)) {
+            return Err(Error::Input(format!(
+                "--trace: a failed run keeps its rows in {}, which is {input}, an input; give --trace another path",
+                partial.display()
+            )));
+        }
+        if let Some((other, _)) = outputs.iter().find(|(_, p)| output::same_file(&partial, p)) {
+            return Err(Error::Input(format!(
+                "--trace: a failed run keeps its rows in {}, which is {other}'s output; give each its own path",
+                partial.display()
+            )));
+        }
+    }
     for (flag, path) in files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))) {
         output::check_output(flag, path)?;
     }
@@ -360,8 +412,18 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
         if dir.exists() && !dir.is_dir() {
             return Err(Error::Input(format!("--frames: cannot create directory {}: a file is there", dir.display())));
         }
+        let others: Vec<(&str, &Path)> = outputs.iter().copied().filter(|(flag, _)| *flag != "--frames").collect();
+        output::check_frames_dir(dir, &inputs, &others)?;
     }
     Ok(())
+}
+
+/// Where a failed run keeps the trace's rows: `TRACE.partial` (or, when a
+/// file is there, `TRACE.partial.1`, ...: `AtomicFile::keep_beside`).
+fn partial_path(trace: &Path) -> PathBuf {
+    let mut partial = trace.as_os_str().to_os_string();
+    partial.push(".partial");
+    PathBuf::from(partial)
 }
 
 fn run(args: RunArgs) -> Result<(), Error> {
@@ -456,31 +518,36 @@ fn run(args: RunArgs) -> Result<(), Error> {
             .map_err(|e| Error::Input(format!("--state-out: {e}")))?;
     }
     let ms = wall.as_secs_f64() * 1e3 / args.steps.max(1) as f64;
-    println!(
+    outln!(
         "{} bodies, {} steps of {:.5} s ({:.3} s simulated) on {}",
         bodies.len(),
         world.step_count(),
         scene.settings.dt,
         world.time(),
         gpu.describe()
-    );
-    println!("set-up {:.2} s, stepping {:.2} s ({ms:.3} ms/step, wall clock)", setup.as_secs_f64(), wall.as_secs_f64());
+    )?;
+    outln!("set-up {:.2} s, stepping {:.2} s ({ms:.3} ms/step, wall clock)", setup.as_secs_f64(), wall.as_secs_f64())?;
     if let Some((stage_ms, timed_by_gpu)) = stage_ms {
         let source = if timed_by_gpu { "GPU timestamps" } else { "wall clock per pass" };
-        println!("per stage, ms/step ({source}):");
+        outln!("per stage, ms/step ({source}):")?;
         for (stage, total) in &stage_ms {
-            println!("  {:<18} {:>9.3}", stage.name(), total / args.steps.max(1) as f64);
+            outln!("  {:<18} {:>9.3}", stage.name(), total / args.steps.max(1) as f64)?;
         }
     }
     if let Some(dir) = &args.frames {
-        println!("{frames_written} frames in {}", dir.display());
+        outln!("{frames_written} frames in {}", dir.display())?;
     }
     let report = world.contact_report()?;
     if args.profile {
-        println!(
+        outln!(
             "contacts in the last step: {} candidate pairs, {} manifolds (most in a step: {}, {}; room for {}, {})",
-            report.pairs, report.manifolds, report.pairs_max, report.manifolds_max, report.pair_capacity, report.manifold_capacity
-        );
+            report.pairs,
+            report.manifolds,
+            report.pairs_max,
+            report.manifolds_max,
+            report.pair_capacity,
+            report.manifold_capacity
+        )?;
     }
     if report.overflowed() {
         eprintln!(
@@ -496,13 +563,13 @@ fn run(args: RunArgs) -> Result<(), Error> {
         };
         let (moving, speed) = fastest(|b| b.linear_velocity);
         let (spinning, spin) = fastest(|b| b.angular_velocity);
-        println!(
+        outln!(
             "lowest body {lowest} at y = {:.3} m; fastest body {speed:.3} m/s (body {moving}); fastest spin {spin:.3} rad/s (body {spinning})",
             b.position[1]
-        );
+        )?;
     }
     if world.at_rest() {
-        println!("at rest: every body asleep or fixed; steps from then on change nothing and were counted, not run");
+        outln!("at rest: every body asleep or fixed; steps from then on change nothing and were counted, not run")?;
     }
     Ok(())
 }
@@ -653,7 +720,7 @@ impl Recorder {
         if let Some(renderer) = self.renderer.as_mut() {
             let image = renderer.render(world)?;
             if let Some(dir) = &self.frames_dir {
-                let path = dir.join(format!("frame_{:06}.png", self.frames_written));
+                let path = dir.join(output::frame_name(self.frames_written));
                 render::write_png(&image, &path).map_err(|e| Error::Input(format!("--frames: {e}")))?;
             }
             self.frames_written += 1;
@@ -686,20 +753,22 @@ impl Recorder {
     }
 
     /// After a failed run: keeps the trace rows recorded so far beside the
-    /// trace's path (`PATH.partial`), never at it, and says on stderr what
-    /// was kept and what was not written.
+    /// trace's path (`PATH.partial`, or `PATH.partial.1`, ... when a file is
+    /// there: none is replaced), never at it, and says on stderr what was
+    /// kept and what was not written.
     fn abandon(self, args: &RunArgs) {
         let upto = match self.last_step {
             Some(step) => format!("steps 0 to {step}"),
             None => "no step".to_string(),
         };
         if let Some((path, file)) = self.trace {
-            let mut partial = path.clone().into_os_string();
-            partial.push(".partial");
-            let partial = PathBuf::from(partial);
+            let partial = partial_path(&path);
             let kept = match self.last_step {
-                Some(_) => match file.keep_as(&partial) {
-                    Ok(()) => format!("its rows of {upto} are in {}", partial.display()),
+                Some(_) => match file.keep_beside(&partial) {
+                    Ok(kept) if kept == partial => format!("its rows of {upto} are in {}", kept.display()),
+                    Ok(kept) => {
+                        format!("its rows of {upto} are in {} ({} was there already, and stays)", kept.display(), partial.display())
+                    }
                     Err(e) => format!("its rows could not be kept: {e}"),
                 },
                 None => "no rows were recorded".to_string(),
@@ -775,42 +844,42 @@ fn info() -> Result<(), Error> {
     let gpu = Gpu::new()?;
     let i = &gpu.info;
     let l = &gpu.limits;
-    println!("adapter:  {}", i.name);
-    println!("backend:  {:?}", i.backend);
-    println!("type:     {:?}", i.device_type);
-    println!("driver:   {} {}", i.driver, i.driver_info);
-    println!("timestamp queries: {}", gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY));
-    println!("max storage buffer binding: {} bytes", l.max_storage_buffer_binding_size);
-    println!("max buffer size:            {} bytes", l.max_buffer_size);
-    println!("max storage buffers/stage:  {}", l.max_storage_buffers_per_shader_stage);
-    println!("max workgroups/dimension:   {}", l.max_compute_workgroups_per_dimension);
+    outln!("adapter:  {}", i.name)?;
+    outln!("backend:  {:?}", i.backend)?;
+    outln!("type:     {:?}", i.device_type)?;
+    outln!("driver:   {} {}", i.driver, i.driver_info)?;
+    outln!("timestamp queries: {}", gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY))?;
+    outln!("max storage buffer binding: {} bytes", l.max_storage_buffer_binding_size)?;
+    outln!("max buffer size:            {} bytes", l.max_buffer_size)?;
+    outln!("max storage buffers/stage:  {}", l.max_storage_buffers_per_shader_stage)?;
+    outln!("max workgroups/dimension:   {}", l.max_compute_workgroups_per_dimension)?;
     use verlet::world::MANIFOLDS_PER_BODY;
     use verlet::world::{body_bytes, bytes_per_body, manifold_bytes, pair_bytes, PAIRS_PER_BODY, SHRINK_AFTER_STEPS};
-    println!(
+    outln!(
         "GPU memory per body:        {} bytes as a world is made: {} its own, {} its share of the contact pools ({PAIRS_PER_BODY} pairs, {MANIFOLDS_PER_BODY} manifolds)",
         bytes_per_body(),
         body_bytes(),
         bytes_per_body() - body_bytes()
-    );
-    println!(
+    )?;
+    outln!(
         "contact pools:              {} bytes a pair, {} a manifold, by need: grown when a step fills three quarters, \
          made twice the need when {SHRINK_AFTER_STEPS} steps in a row fill less than a quarter (sleepers hold none)",
         pair_bytes(),
         manifold_bytes()
-    );
+    )?;
     let (most_pairs, most_manifolds) = verlet::world::pair_capacities(&gpu, u64::MAX);
-    println!("contact pools at most:      {most_pairs} pairs, {most_manifolds} manifolds");
-    println!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu));
+    outln!("contact pools at most:      {most_pairs} pairs, {most_manifolds} manifolds")?;
+    outln!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu))?;
     if i.name.contains("llvmpipe") {
         // lavapipe hands every dispatch to its worker threads, and that
         // hand-off is most of a small scene's step (README: "On a software
         // adapter")
         let threads =
             std::env::var("LP_NUM_THREADS").map_or("LP_NUM_THREADS unset: its default".into(), |t| format!("LP_NUM_THREADS={t}"));
-        println!(
+        outln!(
             "software adapter:           lavapipe's worker threads take each dispatch ({threads}); \
              LP_NUM_THREADS=0 runs them on the submitting thread, faster for scenes of up to a few hundred bodies"
-        );
+        )?;
     }
     Ok(())
 }

@@ -86,18 +86,81 @@ impl AtomicFile {
         self.finish_as(&dest)
     }
 
-    /// Flushes what was written and renames it to `other` instead (a run's
-    /// partial output, kept apart from the destination).
-    pub fn keep_as(mut self, other: &Path) -> Result<(), Error> {
-        self.finish_as(other)
+    /// Flushes what was written and keeps it under `first`, or when a file
+    /// (or anything) is there, under the first of `first.1`, `first.2`, ...
+    /// that is free (a run's partial output, kept apart from the
+    /// destination). Never replaces a file: the name is taken by a hard link
+    /// (or, where the file system has none, a file created new), both of
+    /// which fail on an existing name. Returns the path kept.
+    pub fn keep_beside(mut self, first: &Path) -> Result<PathBuf, Error> {
+        let writer = self.writer.take().expect("finished once");
+        let kept = match writer.into_inner() {
+            Ok(file) => {
+                drop(file);
+                keep_new(&self.temp, first)
+            }
+            // the bytes were on their way to `first`, not to the destination
+            Err(e) => Err(io_err(first, e.into_error())),
+        };
+        let _ = std::fs::remove_file(&self.temp);
+        kept
     }
 
+    /// Flushes and renames; on any failure (a full disk shows first at the
+    /// flush) the temporary file is removed, so none stays behind.
     fn finish_as(&mut self, path: &Path) -> Result<(), Error> {
         let writer = self.writer.take().expect("finished once");
-        let file = writer.into_inner().map_err(|e| io_err(&self.dest, e.into_error()))?;
-        drop(file);
-        std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
+        let done = match writer.into_inner() {
+            Ok(file) => {
+                drop(file);
+                std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
+            }
+            Err(e) => Err(io_err(&self.dest, e.into_error())),
+        };
+        if done.is_err() {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+        done
     }
+}
+
+/// The most numbered names [`AtomicFile::keep_beside`] tries.
+const KEEP_TRIES: usize = 1000;
+
+/// Gives `temp`'s bytes the first free name of `first`, `first.1`, ...;
+/// `temp` itself stays (the caller removes it).
+fn keep_new(temp: &Path, first: &Path) -> Result<PathBuf, Error> {
+    for k in 0..KEEP_TRIES {
+        let path = if k == 0 {
+            first.to_path_buf()
+        } else {
+            let mut name = first.as_os_str().to_os_string();
+            name.push(format!(".{k}"));
+            PathBuf::from(name)
+        };
+        match std::fs::hard_link(temp, &path) {
+            Ok(()) => return Ok(path),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            // no hard links here (or across devices): copy into a file made new
+            Err(_) => match std::fs::OpenOptions::new().write(true).create_new(true).open(&path) {
+                Ok(mut out) => {
+                    let copied =
+                        File::open(temp).and_then(|mut from| std::io::copy(&mut from, &mut out)).and_then(|_| out.sync_all());
+                    return match copied {
+                        Ok(()) => Ok(path),
+                        Err(source) => {
+                            // the file is this run's own: no half copy stays
+                            let _ = std::fs::remove_file(&path);
+                            Err(io_err(&path, source))
+                        }
+                    };
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(source) => return Err(io_err(&path, source)),
+            },
+        }
+    }
+    Err(Error::Input(format!("{} and {} more numbered names beside it are all taken", first.display(), KEEP_TRIES - 1)))
 }
 
 impl Drop for AtomicFile {
@@ -166,6 +229,57 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     resolve(a) == resolve(b)
 }
 
+/// The name of the `k`-th PNG frame that `--frames DIR` writes into DIR.
+pub fn frame_name(k: u64) -> String {
+    format!("frame_{k:06}.png")
+}
+
+/// Whether a frame written by `--frames` may take this name
+/// (`frame_` then six or more digits, `.png`; see [`frame_name`]).
+pub fn is_frame_name(name: &std::ffi::OsStr) -> bool {
+    let name = name.as_encoded_bytes();
+    let digits = name.strip_prefix(b"frame_").and_then(|rest| rest.strip_suffix(b".png"));
+    digits.is_some_and(|d| d.len() >= 6 && d.iter().all(u8::is_ascii_digit))
+}
+
+/// Refuses, for `--frames DIR`, an input or another output that a frame
+/// would replace: a file in DIR under a frame's name (compared as files,
+/// through links), or a frame-named link in DIR to one.
+pub fn check_frames_dir(dir: &Path, inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Result<(), Error> {
+    let named = |path: &Path| {
+        inputs
+            .iter()
+            .find(|(_, p)| same_file(path, p))
+            .map(|(input, _)| format!("{input}, an input"))
+            .or_else(|| outputs.iter().find(|(_, p)| same_file(path, p)).map(|(flag, _)| format!("{flag}'s output")))
+    };
+    let refuse = |path: &Path, what: String| {
+        Err(Error::Input(format!(
+            "--frames: a frame written into {} would overwrite {}, which is {what}; give another directory",
+            dir.display(),
+            path.display()
+        )))
+    };
+    for (_, path) in inputs.iter().chain(outputs) {
+        let real = resolve(path);
+        let in_dir = real.parent().is_some_and(|p| same_file(p, dir));
+        if in_dir && real.file_name().is_some_and(is_frame_name) {
+            return refuse(path, named(path).unwrap_or_default());
+        }
+    }
+    // a frame-named link in DIR to a file elsewhere: the frame would be written through it
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for entry in entries.flatten() {
+            if is_frame_name(&entry.file_name()) {
+                if let Some(what) = named(&entry.path()) {
+                    return refuse(&entry.path(), what);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Refuses an output that names an input, or the same file as another
 /// output: `(flag, path)` pairs, the flag as the user gave it (a scene
 /// file given without a flag is named "the scene").
@@ -185,4 +299,70 @@ pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Re
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh empty directory under the temp dir.
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("verlet-output-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> =
+            std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_failed_commit_or_keep_leaves_no_temporary_file() {
+        let dir = scratch("failed-commit");
+        // the destination turns into a directory with a file in it: the rename fails
+        let dest = dir.join("out.csv");
+        let mut file = AtomicFile::create(&dest).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        std::fs::create_dir(&dest).unwrap();
+        std::fs::write(dest.join("inside"), b"x").unwrap();
+        assert!(file.commit().is_err());
+        assert_eq!(listing(&dir), ["out.csv"]);
+        // no directory for the kept rows: the keep fails, naming where they were to go
+        let dest = dir.join("t.csv");
+        let mut file = AtomicFile::create(&dest).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        let nowhere = dir.join("no").join("t.csv.partial");
+        let err = file.keep_beside(&nowhere).unwrap_err().to_string();
+        assert!(err.contains("t.csv.partial"), "{err}");
+        assert_eq!(listing(&dir), ["out.csv"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn kept_rows_take_the_first_free_name() {
+        let dir = scratch("keep");
+        let first = dir.join("t.csv.partial");
+        std::fs::write(&first, b"mine").unwrap();
+        std::fs::write(dir.join("t.csv.partial.1"), b"mine too").unwrap();
+        let mut file = AtomicFile::create(&dir.join("t.csv")).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        assert_eq!(file.keep_beside(&first).unwrap(), dir.join("t.csv.partial.2"));
+        assert_eq!(std::fs::read(&first).unwrap(), b"mine");
+        assert_eq!(std::fs::read(dir.join("t.csv.partial.2")).unwrap(), b"rows\n");
+        assert_eq!(listing(&dir), ["t.csv.partial", "t.csv.partial.1", "t.csv.partial.2"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn frame_names_are_recognised() {
+        assert!(is_frame_name(frame_name(0).as_ref()));
+        assert!(is_frame_name(frame_name(12_345_678).as_ref()));
+        for name in ["frame_1.png", "frame_000001.PNG", "frame_00000a.png", "xframe_000001.png", "frame_000001.png.tmp"] {
+            assert!(!is_frame_name(name.as_ref()), "{name}");
+        }
+    }
 }

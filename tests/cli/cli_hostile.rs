@@ -236,15 +236,20 @@ fn unusable_output_paths_are_refused_before_the_first_step() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
-    let (dir, _, _) = workdir("failed");
-    // body 1 of a row flies off at 2e5 m/s: the numerical fault stops the run
+/// A scene whose run fails a few steps in: body 1 of a row flies off at
+/// 2e5 m/s, and the numerical fault stops the run.
+fn flying_scene() -> String {
     let mut scene = scenes::stack(0);
     scene.bodies = (0..3).map(|k| scenes::box_body([0.5; 3], [10.0 * k as f32, 0.5, 0.0])).collect();
     scene.bodies[1].linear_velocity = [0.0, 0.0, 2e5];
+    scene.to_json()
+}
+
+#[test]
+fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
+    let (dir, _, _) = workdir("failed");
     let bad = dir.join("bad.json");
-    std::fs::write(&bad, scene.to_json()).unwrap();
+    std::fs::write(&bad, flying_scene()).unwrap();
     let (trace, state, frames) = (dir.join("trace.csv"), dir.join("state.json"), dir.join("frames"));
     std::fs::write(&trace, "an old trace\n").unwrap();
     std::fs::write(&state, "an old state\n").unwrap();
@@ -282,6 +287,96 @@ fn a_failed_run_keeps_the_old_outputs_and_says_what_it_kept() {
     // no half-written or temporary file anywhere
     assert_eq!(listing(&dir), ["bad.json", "frames", "scene.json", "state.json", "trace.csv", "trace.csv.partial"]);
     assert_eq!(listing(&frames), ["frame_000000.png"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_partial_trace_of_a_failed_run_replaces_no_file() {
+    let (dir, _, _) = workdir("partial");
+    // the scene, or another output, where the partial rows would go: refused before anything runs
+    let scene = dir.join("t.csv.partial");
+    let text = flying_scene();
+    std::fs::write(&scene, &text).unwrap();
+    let (sc, trace) = (s(&scene), dir.join("t.csv"));
+    let other = dir.join("o.csv");
+    let other_partial = format!("{}.partial", s(&other));
+    for (args, wanted) in [
+        (vec!["run", sc, "--steps", "30", "--trace", s(&trace)], vec!["--trace", sc, "scene file"]),
+        (
+            vec!["run", "--builtin", "drop", "--steps", "30", "--trace", s(&other), "--state-out", &other_partial],
+            vec!["--trace", &other_partial, "--state-out"],
+        ),
+        (
+            vec!["run", "--builtin", "drop", "--steps", "30", "--trace", s(&other), "--frames", &other_partial],
+            vec!["--trace", "--frames"],
+        ),
+    ] {
+        let (out, _) = capped(&args);
+        assert_refused(&args, &out, &wanted);
+        assert_eq!(std::fs::read_to_string(&scene).unwrap(), text, "{args:?}: the scene changed");
+        assert_eq!(listing(&dir), ["scene.json", "t.csv.partial"], "{args:?}: files were made");
+    }
+    // a user's file there stays; the rows go to the next free name
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, &text).unwrap();
+    let mine = dir.join("u.csv.partial");
+    std::fs::write(&mine, "USERDATA\n").unwrap();
+    let trace = dir.join("u.csv");
+    let args = ["run", s(&bad), "--steps", "30", "--trace", s(&trace)];
+    let (out, _) = capped(&args);
+    if no_adapter(&out) {
+        return;
+    }
+    assert_refused(&args, &out, &["body 1 became absurd"]);
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "USERDATA\n", "the user's file was replaced");
+    let kept = dir.join("u.csv.partial.1");
+    let rows = std::fs::read_to_string(&kept).expect("the rows go to the next free name");
+    assert!(rows.starts_with(verlet::output::TRACE_HEADER), "{rows}");
+    assert!(stderr(&out).contains(s(&kept)), "{}", stderr(&out));
+    assert_eq!(listing(&dir), ["bad.json", "scene.json", "t.csv.partial", "u.csv.partial", "u.csv.partial.1"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn frames_would_overwrite_no_input_or_output() {
+    let (dir, _, text) = workdir("frames-clash");
+    let frame_scene = dir.join("frame_000001.png");
+    std::fs::write(&frame_scene, &text).unwrap();
+    let (d, fs) = (s(&dir), s(&frame_scene));
+    let (gif, state) = (format!("{d}/frame_000002.png"), format!("{d}/frame_000003.png"));
+    let small = ["--width", "8", "--height", "8"];
+    for (args, wanted) in [
+        (vec!["run", fs, "--steps", "2", "--frames", d], vec!["--frames", fs, "scene file"]),
+        (vec!["run", "--builtin", "drop", "--steps", "2", "--frames", d, "--gif", &gif], vec!["--frames", &gif, "--gif"]),
+        (vec!["run", "--builtin", "drop", "--steps", "2", "--frames", d, "--state-out", &state], vec!["--frames", "--state-out"]),
+    ] {
+        let args: Vec<&str> = args.into_iter().chain(small).collect();
+        let (out, _) = capped(&args);
+        assert_refused(&args, &out, &wanted);
+        assert_eq!(std::fs::read(&frame_scene).unwrap(), text, "{args:?}: the scene changed");
+        assert_eq!(listing(&dir), ["frame_000001.png", "scene.json"], "{args:?}: files were made");
+    }
+    // a frame-named link in the directory to an input elsewhere: the frame would go through it
+    #[cfg(unix)]
+    {
+        let (other, scene, _) = workdir("frames-link");
+        std::os::unix::fs::symlink(&scene, other.join("frame_000000.png")).unwrap();
+        let args = ["run", s(&scene), "--steps", "2", "--frames", s(&other), "--width", "8", "--height", "8"];
+        let (out, _) = capped(&args);
+        assert_refused(&args, &out, &["--frames", "frame_000000.png", "scene file"]);
+        assert_eq!(std::fs::read(&scene).unwrap(), text);
+        let _ = std::fs::remove_dir_all(&other);
+    }
+    // the scene in the frames directory under another name is no clash
+    let scene = dir.join("scene.json");
+    std::fs::remove_file(&frame_scene).unwrap();
+    let (out, _) = capped(&["run", s(&scene), "--steps", "2", "--frames", d, "--width", "8", "--height", "8"]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read(&scene).unwrap(), text);
+    assert_eq!(listing(&dir), ["frame_000000.png", "frame_000001.png", "frame_000002.png", "scene.json"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -454,6 +549,28 @@ fn malformed_scene_files_are_named_with_the_line() {
 }
 
 #[test]
+fn endless_or_huge_files_are_refused_without_reading_them_whole() {
+    let (dir, _, _) = workdir("endless");
+    // a NUL byte is no JSON: /dev/zero fails at its first byte, not at the OOM killer
+    for args in [&["run", "/dev/zero", "--steps", "1"][..], &["run", "--builtin", "drop", "--steps", "1", "--input", "/dev/zero"]] {
+        let (out, _) = capped(args);
+        assert_refused(args, &out, &["/dev/zero", "line 1, column 1", "NUL byte"]);
+    }
+    let nul = dir.join("nul.json");
+    std::fs::write(&nul, b"{\n  \"bodies\": [\0").unwrap();
+    let args = ["run", s(&nul), "--steps", "1"];
+    let (out, _) = capped(&args);
+    assert_refused(&args, &out, &[s(&nul), "line 2, column 14", "NUL byte"]);
+    // a file over the cap (sparse: it takes no disk) is refused by its size, naming it
+    let huge = dir.join("huge.json");
+    std::fs::File::create(&huge).unwrap().set_len(verlet::load_error::MAX_FILE_BYTES + 1).unwrap();
+    let args = ["run", s(&huge), "--steps", "1"];
+    let (out, _) = capped(&args);
+    assert_refused(&args, &out, &[s(&huge), "scene file", &verlet::load_error::MAX_FILE_BYTES.to_string()]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_scene_given_as_a_track_is_called_a_scene() {
     let (dir, scene, original) = workdir("scene-as-track");
     assert_refused_quickly(&["run", "--builtin", "drop", "--steps", "1", "--input", s(&scene)], &["--input", "scene"]);
@@ -496,6 +613,72 @@ fn track_events_after_the_last_step_are_warned_of() {
     }
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("warning: --input: 1 of 2 events"), "{}", stderr(&out));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Runs `verlet args` under the 4 GB cap with stdout going to `stdout`.
+fn capped_to(args: &[&str], stdout: std::process::Stdio) -> std::process::Child {
+    Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 4000000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_verlet"))
+        .args(args)
+        .stdout(stdout)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("sh runs verlet")
+}
+
+#[test]
+fn a_closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
+    // the reader goes before the scene (3 MB, more than a pipe holds) is written
+    let mut child = capped_to(&["scene", "cubes", "--count", "10000"], std::process::Stdio::piped());
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(141), "128 + SIGPIPE, as a shell reports `yes | head`: {}", stderr(&out));
+    assert_eq!(stderr(&out), "", "a closed pipe is no error to report");
+    #[cfg(target_os = "linux")]
+    for args in [&["scene", "cubes", "--count", "3"][..], &["info"], &["run", "--builtin", "drop", "--steps", "2"]] {
+        let full = std::fs::File::create("/dev/full").unwrap();
+        let out = capped_to(args, full.into()).wait_with_output().unwrap();
+        if no_adapter(&out) {
+            continue;
+        }
+        assert_refused(args, &out, &["stdout", "No space left"]);
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn bench_takes_an_output_path_that_is_not_utf8() {
+    use std::os::unix::ffi::OsStrExt;
+    let (dir, _, _) = workdir("bench-bytes");
+    let json = dir.join(std::ffi::OsStr::from_bytes(b"x\xff.json"));
+    let out = Command::new(env!("CARGO_BIN_EXE_verlet"))
+        .args([
+            "bench",
+            "--no-peer",
+            "--cases",
+            "cubes:10",
+            "--steps",
+            "2",
+            "--reps",
+            "1",
+            "--profile-steps",
+            "0",
+            "--settle-steps",
+            "0",
+        ])
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert!(report["command"].as_str().unwrap().contains("x\u{fffd}.json"), "{}", report["command"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
