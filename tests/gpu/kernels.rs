@@ -135,6 +135,14 @@ fn a_lattice_of_cells_eight_apart_spreads_over_the_buckets() {
 }
 
 /// `bodies` with no ground and no gravity.
+/// `n` unit boxes placed inside each other, their centres within 5 cm,
+/// weightless: every pair of them touches, all in one cell of the grid.
+fn boxes_inside_each_other(n: usize, seed: u64) -> Scene {
+    let mut rng = Rng(seed);
+    let at = |rng: &mut Rng| [rng.range(0.0, 0.05), 3.0 + rng.range(0.0, 0.05), rng.range(0.0, 0.05)];
+    weightless((0..n).map(|_| box_body([0.5; 3], at(&mut rng))).collect())
+}
+
 fn weightless(bodies: Vec<verlet::Body>) -> Scene {
     Scene { settings: Settings { gravity: [0.0; 3], ..Settings::default() }, ground: None, bodies, joints: vec![], camera: None }
 }
@@ -363,10 +371,7 @@ fn the_pair_list_holds_every_pair_within_reach_once_at_any_speed() {
 #[test]
 fn boxes_placed_inside_each_other_want_every_pair() {
     let n = 600;
-    let mut rng = Rng(0x5851_f42d_4c95_7f2d);
-    let bodies =
-        (0..n).map(|_| box_body([0.5; 3], [rng.range(0.0, 0.05), 3.0 + rng.range(0.0, 0.05), rng.range(0.0, 0.05)])).collect();
-    let scene = weightless(bodies);
+    let scene = boxes_inside_each_other(n, 0x5851_f42d_4c95_7f2d);
     let Some(mut w) = world(&scene) else { return };
     let stages: Vec<Stage> =
         w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
@@ -522,10 +527,7 @@ fn contact_lists_put_each_body_s_manifolds_in_pair_order() {
 #[test]
 fn long_lists_in_random_order_come_out_in_pair_order() {
     let n = 600;
-    let mut rng = Rng(0x1405_7b7e_f767_814f);
-    let bodies =
-        (0..n).map(|_| box_body([0.5; 3], [rng.range(0.0, 0.05), 3.0 + rng.range(0.0, 0.05), rng.range(0.0, 0.05)])).collect();
-    let scene = weightless(bodies);
+    let scene = boxes_inside_each_other(n, 0x1405_7b7e_f767_814f);
     let Some(mut w) = world(&scene) else { return };
     w.step(1).unwrap();
     let (meta, _) = lists_after_contact_lists(&mut w);
