@@ -344,14 +344,15 @@ fn grid_key(i: u32) -> f32 {
 // same order every run, and lets a pair walk stop at the first body of a
 // cell whose box begins beyond the walker's reach along x (see pairs.wgsl).
 // Each body counts the bodies of its bucket that come before it (by key,
-// then index): a loop as long as its bucket. (An insertion sort of each bucket by one
-// invocation took a loop as long as the bucket's inversions, about n^2/4
-// for n bodies at one place, and lavapipe ends every loop of an invocation
-// once their trips sum to 65535 (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS),
-// silently: from 510 boxes placed inside each other their bucket stayed
-// unsorted and most of their pairs were never found.) The bucket's bodies'
-// bounds go to cell_bounds in that order, where the walks read a cell's
-// candidates side by side (CellBound).
+// then index): a loop as long as its bucket. (An insertion sort of each
+// bucket by one invocation took a loop as long as the bucket's
+// inversions, about n^2/4 for n bodies at one place, and lavapipe ends
+// every loop of an invocation once their trips sum to 65535 (gallivm's
+// LP_MAX_TGSI_LOOP_ITERATIONS), silently: from 510 boxes placed inside
+// each other their bucket stayed unsorted and most of their pairs were
+// never found.) The bucket's bodies' bounds go to cell_bounds in that
+// order, where the walks read a cell's candidates side by side
+// (CellBound).
 @compute @workgroup_size(WORKGROUP)
 fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;

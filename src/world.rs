@@ -443,6 +443,8 @@ impl World {
         scene.validate()?;
         let n = scene.bodies.len();
         check_capacity(&gpu, n)?;
+        let joints = joint_lists(scene);
+        check_islands(&gpu, &joints, n)?;
         let settings = scene.settings;
         let device = &gpu.device;
         let count = n.max(1); // wgpu buffers may not be empty
@@ -488,8 +490,6 @@ impl World {
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let joints = joint_lists(scene);
-        check_islands(&gpu, &joints, n)?;
         let joint_start = with_data("joints/start", bytemuck::cast_slice(&joints.starts));
         let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&joints.refs));
         let params = device.create_buffer(&wgpu::BufferDescriptor {
