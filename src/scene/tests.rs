@@ -168,6 +168,11 @@ fn errors_name_the_field() {
         (body(r#", "restitution": 1.5"#), "bodies[1].restitution: must be in [0, 1], got 1.5"),
         (body(r#", "linear_velocity": [0, 1e39, 0]"#), "bodies[1].linear_velocity[1]: must be a finite number, got inf"),
         (body(r#", "angular_velocity": [0, 1e999, 0]"#), "bodies[1].angular_velocity[1]: number out of range"),
+        (
+            r#"{"bodies": [{"shape": {"type": "sphere", "radius": 1}, "position": [0, 1e7, 0], "fixed": true}]}"#.to_string(),
+            "bodies[0].position: lies 1.0000e7 m from the origin; at most 1e6 m",
+        ),
+        (body(r#", "linear_velocity": [3e4, 0, 0]"#), "bodies[1].linear_velocity: moves at 3.0000e4 m/s; at most 1e4 m/s"),
         (body(r#", "fixed": 1"#), "bodies[1].fixed: invalid type"),
         (r#"{"settings": {"dt": -0.1}}"#.to_string(), "settings.dt: must be positive, got -0.1"),
         (r#"{"settings": {"iterations": 0}}"#.to_string(), "settings.iterations: must be between 1 and 256, got 0"),

@@ -114,7 +114,24 @@ pub(super) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Res
     check_orientation(body.orientation, &format!("{path}.orientation"))?;
     check_all_finite(&body.linear_velocity, &format!("{path}.linear_velocity"))?;
     check_all_finite(&body.angular_velocity, &format!("{path}.angular_velocity"))?;
+    // what the step would stop at once as a numerical fault (integrate.wgsl)
+    use crate::world::{MAX_DISTANCE, MAX_SPEED};
+    let length = |v: [f32; 3]| v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+    let distance = length(body.position);
+    if distance > MAX_DISTANCE as f64 {
+        return Err(SceneError::invalid(
+            format!("{path}.position"),
+            format!("lies {distance:.4e} m from the origin; at most {MAX_DISTANCE:e} m is sane (the step stops a body beyond it)"),
+        ));
+    }
     if !body.fixed {
+        let speed = length(body.linear_velocity);
+        if speed > MAX_SPEED as f64 {
+            return Err(SceneError::invalid(
+                format!("{path}.linear_velocity"),
+                format!("moves at {speed:.4e} m/s; at most {MAX_SPEED:e} m/s is sane (the step stops a faster body)"),
+            ));
+        }
         if let Some(why) = spin_problem(body.angular_velocity, settings.dt / settings.substeps as f32) {
             return Err(SceneError::invalid(format!("{path}.angular_velocity"), why));
         }
