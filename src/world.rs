@@ -582,6 +582,12 @@ impl World {
         let dt = self.settings.dt;
         let mut left = steps;
         while left > 0 {
+            if self.at_rest {
+                // nothing moves: the steps are counted at once, not a batch
+                // at a time (a run of 2^64 - 1 steps at rest ended only when
+                // its batches had been counted one by one)
+                return self.skip_at_rest(left, dt);
+            }
             let batch = left.min((MAX_BATCH / self.settings.substeps as usize).max(1) as u64);
             let dts = vec![dt; batch as usize];
             self.step_with(&dts)?;
@@ -705,7 +711,7 @@ impl World {
                 watch.quiet_most[k] = 0;
                 continue;
             }
-            watch.quiet_steps[k] += steps as u64;
+            watch.quiet_steps[k] = watch.quiet_steps[k].saturating_add(steps as u64);
             watch.quiet_most[k] = watch.quiet_most[k].max(wanted[k]);
             let to = (2 * watch.quiet_most[k] as u64).max(MIN_POOL);
             if watch.quiet_steps[k] >= SHRINK_AFTER_STEPS && to < capacity[k] as u64 {
@@ -833,6 +839,18 @@ impl World {
         }
         self.gpu.queue.write_buffer(&self.data.params, 0, &slots);
         slot
+    }
+
+    /// Counts `steps` steps of `dt` of a world at rest (`at_rest`): what
+    /// `step_with` does for each batch of them, in one go.
+    fn skip_at_rest(&mut self, steps: u64, dt: f32) -> Result<(), Error> {
+        self.skipped = true;
+        self.note_wants([0, 0], usize::try_from(steps).unwrap_or(usize::MAX));
+        self.shrink_pools()?;
+        self.dt_prev = dt / self.settings.substeps as f32;
+        self.step = self.step.saturating_add(steps);
+        self.time += steps as f64 * dt as f64;
+        Ok(())
     }
 
     fn finish_steps(&mut self, dts: &[f32], substeps: usize) {

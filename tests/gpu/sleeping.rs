@@ -315,8 +315,9 @@ fn speeds_in_and_out(w: &mut verlet::World, i: usize, toward: [f32; 3], steps: u
 /// A world whose bodies all sleep is at rest: its steps would leave every
 /// pose as it is, so they are counted and skipped, as listing no contacts
 /// (the pools shrink as if they had run). A fresh world restored from it
-/// runs its first batch on the GPU and comes out with the same bits; an
-/// impulse wakes the bodies and the steps run again.
+/// runs its first batch on the GPU and comes out with the same bits, and
+/// counts 2^64 - 1 steps more at once; an impulse wakes the bodies and the
+/// steps run again.
 #[test]
 fn a_world_at_rest_skips_its_steps_until_an_input_wakes_it() {
     let mut scene = scenes::drop();
@@ -353,6 +354,11 @@ fn a_world_at_rest_skips_its_steps_until_an_input_wakes_it() {
     run.step(skipped).unwrap();
     assert!(run.at_rest(), "the restored world did not find itself at rest");
     assert!(bits(&run) == rested, "stepping the resting world moved a pose");
+    // however many steps are asked of a world at rest, they are counted at
+    // once (2^64 - 1 of them, a batch at a time, never ended)
+    run.step(u64::MAX - run.step_count()).unwrap();
+    assert_eq!(run.step_count(), u64::MAX);
+    assert!(run.at_rest() && bits(&run) == rested, "the counted steps moved a pose");
     // an input wakes it
     w.apply_impulse(1, [0.0, 5000.0, 0.0], None).unwrap();
     assert!(!w.at_rest());
