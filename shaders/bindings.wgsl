@@ -55,8 +55,15 @@
 // its steps until an input, see World::at_rest); status[16]: how many
 // bodies the step's body passes run over (`listed_body`);
 // status[17..20]: their indirect dispatch (workgroups over them, 1, 1),
-// counted by contact_lists and copied out after it; 20 words
+// counted by contact_lists and copied out after it; status[20]: 1 once a
+// pair walk took so many loop trips that the driver may have cut it short
+// (LOOP_TRIPS, see pairs.wgsl), never cleared; 21 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
+
+// The most trips an invocation's loops may take, summed (`Gpu::loop_trips`):
+// lavapipe ends every loop of an invocation once their trips sum to 65535,
+// silently (ARCHITECTURE.md, Adding a stage, 8). Unlimited elsewhere.
+override LOOP_TRIPS: u32 = 0xffffffffu;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1
 @group(0) @binding(14) var<storage, read> joint_refs: array<JointRef>;          // 2 per joint

@@ -52,6 +52,7 @@
 // a fifth of pairs_count in a pile with no joints at all.
 fn joined_to_walker(j: u32) -> bool {
     for (var k = walker.joints.x; k < walker.joints.y; k = k + 1u) {
+        trips = trips + 1u;
         if (joint_refs[k].partner == j) {
             return true;
         }
@@ -149,6 +150,13 @@ var<private> walker: Walker;
 var<private> writing: bool;
 var<private> room_start: u32;
 var<private> owned: u32;
+// The walk's loop trips so far (cells, candidates, large bodies, joint
+// ends). Where the driver ends an invocation's loops past LOOP_TRIPS
+// (lavapipe: 65535, summed over the 8 invocations it runs side by side), a
+// walk of more than an eighth of that may have been cut short, silently: a
+// fast body's walk in a large grid (every bucket), or a body with
+// thousands of joints. `note_long_walk` says so in status[20].
+var<private> trips: u32;
 
 // Partners each body's scratch room holds: body_pairs shared out by grid
 // order (the lists have room for every pair twice, so at least twice the
@@ -201,6 +209,7 @@ fn visit_bucket(h: u32, c: vec3<i32>, any_cell: bool, above: u32, behind: bool) 
     let end = cell_start[h + 1u];
     let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
     for (var k = cell_start[h]; k < end; k = k + 1u) {
+        trips = trips + 1u;
         let cb = cell_bound_of(k);
         if (cb.pos.x - cb.extent.x > stop) {
             break;
@@ -269,6 +278,7 @@ fn walk(i: u32) {
     walker = Walker(i, state_of(i).pos, extent, pair_meta[i].bound, size, pair_meta[i].moves == MOVES,
                     grid && is_fast(size, pair_meta[i].moves), vec2<u32>(joint_start[i], joint_start[i + 1u]));
     owned = 0u;
+    trips = 0u;
     if (wants_ground(i)) {
         if (writing) {
             write_owned(GROUND);
@@ -292,6 +302,7 @@ fn walk(i: u32) {
     // (lavapipe's compile time grows steeply with a kernel's size)
     var o = vec3<i32>(0);
     for (var n = 0u; n < cells; n = n + 1u) {
+        trips = trips + 1u;
         // the own cell, the cells ahead, then the same cells behind
         let behind = n > ahead;
         if (n != 0u) {
@@ -301,6 +312,7 @@ fn walk(i: u32) {
         visit_bucket(select(bucket_of(c), n, every), c, every, select(NONE, i, n == 0u), behind);
     }
     for (var k = 0u; k < params.large_count; k = k + 1u) {
+        trips = trips + 1u;
         let j = large_body(k);
         if ((grid || j > i) && wanted_bounds(state_of(j).pos, pair_meta[j].bound, pair_meta[j].extent, pair_meta[j].moves)
             && !joined_to_walker(j)) {
@@ -325,7 +337,15 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     writing = false;
     room_start = gid.x * scratch_room();
     walk(i);
+    note_long_walk();
     pair_meta[i].owned = owned;
+}
+
+// Sets status[20] if this walk may have been cut short (see `trips`).
+fn note_long_walk() {
+    if (trips > LOOP_TRIPS / 8u) {
+        atomicStore(&status[20], 1u);
+    }
 }
 
 @compute @workgroup_size(WORKGROUP)

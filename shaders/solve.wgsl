@@ -413,13 +413,9 @@ fn close_joint(j: JointRef) {
     }
 }
 
-// The most trips an invocation's loops may take, summed (`Gpu::loop_trips`:
-// lavapipe ends them all past 65535, silently; ARCHITECTURE.md, Adding a
-// stage, 8). An island of n joints takes 2n trips to read and set its rest
-// times and 2n a sweep; World::with_gpu refuses one with no room for a
-// sweep. Unlimited elsewhere.
-override LOOP_TRIPS: u32 = 0xffffffffu;
-
+// An island of n joints takes 2n loop trips to read and set its rest times
+// and 2n a sweep, within LOOP_TRIPS (bindings.wgsl); World::with_gpu
+// refuses one with no room for a sweep.
 @compute @workgroup_size(WORKGROUP)
 fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.island_count) {

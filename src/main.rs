@@ -556,6 +556,14 @@ fn run(args: RunArgs) -> Result<(), Error> {
             report.pairs_max, report.pair_capacity, report.manifolds_max, report.manifold_capacity
         );
     }
+    if report.walks_cut {
+        eprintln!(
+            "warning: a body's pair walk was long enough that {} may have cut it short (it ends an invocation's \
+             loops after 65535 trips): a body far faster than its neighbours in a large scene, or one with thousands \
+             of joints, may have missed contacts",
+            gpu.info.name
+        );
+    }
     if let Some((lowest, b)) = bodies.iter().enumerate().min_by(|a, b| a.1.position[1].total_cmp(&b.1.position[1])) {
         let length = |v: [f32; 3]| glam::Vec3::from(v).length();
         let fastest = |of: fn(&verlet::BodyOutput) -> [f32; 3]| {

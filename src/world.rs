@@ -168,11 +168,16 @@ pub struct ContactReport {
     /// held, even once grown (the pools also shrink, so the maxima above
     /// may exceed today's capacities without any loss).
     pub dropped: bool,
+    /// Whether any step so far had a body's pair walk long enough that the
+    /// driver may have cut it short (lavapipe ends an invocation's loops
+    /// past 65535 trips: a body far faster than its neighbours in a large
+    /// scene, or one with thousands of joints); its pairs may be missing.
+    pub walks_cut: bool,
 }
 
-/// Bytes of the `status` buffer the GPU reports through (20 words; see
+/// Bytes of the `status` buffer the GPU reports through (21 words; see
 /// shaders/bindings.wgsl, binding 12).
-const STATUS_BYTES: u64 = 80;
+const STATUS_BYTES: u64 = 84;
 /// `status[2]` and `status[3]` before any fault (`NO_FAULT` in integrate.wgsl).
 pub const NO_FAULT: u32 = u32::MAX;
 /// The speed (m/s) and distance from the origin (m) beyond which a body's
@@ -1159,6 +1164,7 @@ impl World {
             manifolds_max: v[5],
             manifold_capacity,
             dropped: v[1] > pair_capacity || v[5] > manifold_capacity,
+            walks_cut: v[20] != 0,
         }
     }
 
@@ -1254,7 +1260,8 @@ impl World {
 
 /// The status words as made: pair and manifold counts 0 (maxima
 /// atomicMax-ed), no fault (atomicMin-ed), the rest spare.
-const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] = [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1];
+const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] =
+    [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1, 0];
 
 /// The damping per substep that removes `beta` per step: 1 - (1 - beta)^(1/n).
 fn per_substep(beta: f32, substeps: usize) -> f32 {

@@ -278,7 +278,7 @@ impl Stage {
             Stage::GridScanAdd => &[CellStart],
             Stage::GridScatter => &[CellCount, Sorted],
             Stage::GridSort => &[Sorted, CellBounds],
-            Stage::PairsCount => &[Sorted, Pairs, PairMeta, BodyPairs],
+            Stage::PairsCount => &[Sorted, Pairs, Status, PairMeta, BodyPairs],
             Stage::PairsWrite => &[Pairs, PairMeta, BodyPairs],
             Stage::Narrowphase | Stage::NarrowphaseGround => {
                 &[Manifolds, Status, PairMeta, BodyPairs, Points, Points1, Points2, Points3]
@@ -396,7 +396,7 @@ fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
 
 /// Compiles one pass with its layout (the override constants: POOL_SPLIT,
 /// DISPATCH_ROW from the device's limits, SCAN_PAIRS for the pairs' scan,
-/// LOOP_TRIPS for solve_joints where the driver limits loops).
+/// LOOP_TRIPS where the driver limits loops).
 fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: bool) -> wgpu::ComputePipeline {
     let mut constants = vec![
         ("POOL_SPLIT", f64::from(u8::from(pool_split))),
@@ -405,7 +405,7 @@ fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: 
     if stage.scans_pairs() {
         constants.push(("SCAN_PAIRS", 1.0));
     }
-    if let (Stage::SolveJoints, Some(trips)) = (stage, gpu.loop_trips()) {
+    if let Some(trips) = gpu.loop_trips() {
         constants.push(("LOOP_TRIPS", f64::from(trips)));
     }
     let mut one = gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), &constants);

@@ -391,6 +391,30 @@ fn boxes_placed_inside_each_other_want_every_pair() {
     assert_cell_bounds(&w, n);
     let report = w.contact_report().unwrap();
     assert_eq!(report.pairs as usize, n * (n - 1) / 2, "pairs wanted");
+    assert!(!report.walks_cut, "a walk of 600 candidates reported as cut");
+}
+
+/// A walk long enough that the driver may cut it short is reported
+/// (`ContactReport::walks_cut`, status[20]): a ball at 3000 m/s over a
+/// floor of 20 164 cubes walks every one of the grid's 65 536 buckets,
+/// past lavapipe's 65535 loop trips. Where the driver has no such limit,
+/// nothing is reported.
+#[test]
+fn a_walk_the_driver_may_cut_short_is_reported() {
+    let mut bodies: Vec<verlet::Body> =
+        (0..142 * 142).map(|k| box_body([0.5; 3], [(k % 142) as f32 * 1.5 - 106.0, 0.5, (k / 142) as f32 * 1.5 - 106.0])).collect();
+    let mut ball = sphere_body(0.5, [-100.0, 3.0, 0.0]);
+    ball.linear_velocity = [3000.0, 0.0, 0.0];
+    bodies.push(ball);
+    let mut scene = weightless(bodies);
+    scene.settings.sleeping = false;
+    let Some(mut w) = world(&scene) else { return };
+    assert!(w.grid().hash_size >= 65_536, "{:?}", w.grid());
+    let stages: Vec<Stage> =
+        w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
+    w.run_stages(&stages).unwrap();
+    let limited = w.gpu().loop_trips().is_some();
+    assert_eq!(w.contact_report().unwrap().walks_cut, limited, "limited loops: {limited}");
 }
 
 #[test]
