@@ -315,7 +315,9 @@ impl RawBody {
                 let density = density.unwrap_or(DEFAULT_DENSITY);
                 check_positive(density, &density_path)?;
                 check_shape(&shape, &shape_path)?;
-                mass_from_density(density, &shape, &density_path)?
+                // the density given, or the shape's size when none was
+                let blame = if self.density.is_some() { density_path } else { shape_path.clone() };
+                mass_from_density(density, &shape, &blame)?
             }
         };
 

@@ -173,6 +173,10 @@ fn errors_name_the_field() {
             "bodies[0].position: lies 1.0000e7 m from the origin; at most 1e6 m",
         ),
         (body(r#", "linear_velocity": [3e4, 0, 0]"#), "bodies[1].linear_velocity: moves at 3.0000e4 m/s; at most 1e4 m/s"),
+        (
+            r#"{"bodies": [{"shape": {"type": "sphere", "radius": 1e30}, "position": [0, 3, 0]}]}"#.to_string(),
+            "bodies[0].shape: density 1000 kg/m³ times volume inf m³",
+        ),
         (body(r#", "fixed": 1"#), "bodies[1].fixed: invalid type"),
         (r#"{"settings": {"dt": -0.1}}"#.to_string(), "settings.dt: must be positive, got -0.1"),
         (r#"{"settings": {"iterations": 0}}"#.to_string(), "settings.iterations: must be between 1 and 256, got 0"),
