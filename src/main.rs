@@ -445,6 +445,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
     }
     let (file_scene, body_count) = match (&args.scene, &args.builtin) {
         (Some(path), _) => {
+            if args.count.is_some() {
+                eprintln!("warning: --count: a scene file gives its own bodies (--count is for --builtin); ignored");
+            }
             let scene = load_scene(path)?;
             let n = scene.bodies.len() as u64;
             (Some(scene), n)

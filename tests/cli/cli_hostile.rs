@@ -619,6 +619,20 @@ fn track_events_after_the_last_step_are_warned_of() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `--count` with a scene file (it gives its own bodies) is warned of, not
+/// silently ignored.
+#[test]
+fn a_count_given_with_a_scene_file_is_warned_of() {
+    let (dir, scene, _) = workdir("count");
+    let (out, _) = capped(&["run", s(&scene), "--count", "5", "--steps", "1"]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("warning: --count: a scene file gives its own bodies"), "{}", stderr(&out));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Runs `verlet args` under the 4 GB cap with stdout going to `stdout`.
 fn capped_to(args: &[&str], stdout: std::process::Stdio) -> std::process::Child {
     Command::new("sh")
