@@ -178,6 +178,12 @@ fn errors_name_the_field() {
             "bodies[0].shape: density 1000 kg/m³ times volume inf m³",
         ),
         (body(r#", "fixed": 1"#), "bodies[1].fixed: invalid type"),
+        (
+            r#"{"bodies": [{"shape": {"type": "sphere", "radius": 1}, "position": [0, 3, 0]}],
+                "joints": [{"type": "ball", "bodies": [0, -1], "anchors": [[0, 0, 0], [0, 1e7, 0]]}]}"#
+                .to_string(),
+            "joints[0].anchors[1]: lies 1.0000e7 m from the origin; at most 1e6 m",
+        ),
         (r#"{"settings": {"dt": -0.1}}"#.to_string(), "settings.dt: must be positive, got -0.1"),
         (r#"{"settings": {"iterations": 0}}"#.to_string(), "settings.iterations: must be between 1 and 256, got 0"),
         (r#"{"settings": {"iterations": -3}}"#.to_string(), "settings.iterations: invalid value"),

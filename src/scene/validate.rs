@@ -189,7 +189,16 @@ pub(super) fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Re
         return Err(SceneError::invalid(format!("{path}.bodies"), message));
     }
     for (k, anchor) in joint.anchors.iter().enumerate() {
-        check_all_finite(anchor, &format!("{path}.anchors[{k}]"))?;
+        let at = format!("{path}.anchors[{k}]");
+        check_all_finite(anchor, &at)?;
+        // a world point, or an offset from the body's centre: beyond what a
+        // body may reach (it would be stopped as a fault there)
+        use crate::world::MAX_DISTANCE;
+        let distance = anchor.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+        if distance > MAX_DISTANCE as f64 {
+            let from = if joint.bodies[k] == WORLD { "the origin" } else { "its body's centre" };
+            return Err(SceneError::invalid(at, format!("lies {distance:.4e} m from {from}; at most {MAX_DISTANCE:e} m is sane")));
+        }
     }
     Ok(())
 }
