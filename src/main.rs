@@ -418,6 +418,16 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// `s` seconds with `places` decimals, or in scientific notation where
+/// those would show nothing (a step of 1e-6 s is not "0.00000 s").
+fn seconds(s: f64, places: usize) -> String {
+    if s != 0.0 && s.abs() < 10f64.powi(-(places as i32)) {
+        format!("{s:.3e}")
+    } else {
+        format!("{s:.places$}")
+    }
+}
+
 /// Where a failed run keeps the trace's rows: `TRACE.partial` (or, when a
 /// file is there, `TRACE.partial.1`, ...: `AtomicFile::keep_beside`).
 fn partial_path(trace: &Path) -> PathBuf {
@@ -432,6 +442,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if let Some(dt) = args.dt {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::Input(format!("--dt: must be a positive number of seconds, got {dt}")));
+        }
+        if dt < verlet::world::MIN_DT {
+            return Err(Error::Input(format!("--dt: {}", verlet::scene::dt_too_short(dt))));
         }
     }
     if args.every == 0 {
@@ -522,11 +535,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
     }
     let ms = wall.as_secs_f64() * 1e3 / args.steps.max(1) as f64;
     outln!(
-        "{} bodies, {} steps of {:.5} s ({:.3} s simulated) on {}",
+        "{} bodies, {} steps of {} s ({} s simulated) on {}",
         bodies.len(),
         world.step_count(),
-        scene.settings.dt,
-        world.time(),
+        seconds(scene.settings.dt as f64, 5),
+        seconds(world.time(), 3),
         gpu.describe()
     )?;
     outln!("set-up {:.2} s, stepping {:.2} s ({ms:.3} ms/step, wall clock)", setup.as_secs_f64(), wall.as_secs_f64())?;

@@ -188,6 +188,11 @@ pub const MAX_DISTANCE: f32 = 1e6;
 /// in one substep (rad; a pose pair holds under half a turn, pi, per
 /// substep): `MAX_SPIN` and `MAX_TURN` in integrate.wgsl.
 pub const MAX_SPIN: f32 = 1e4;
+/// The shortest step (s) a world takes. The fault checks read a body's
+/// speed as its displacement over the step, and below this the rounding of
+/// the poses reads as speed: at 1e-9 s a pile of cubes at rest was stopped
+/// at its first step as thrown by the solver (1e-8 s still ran).
+pub const MIN_DT: f32 = 1e-6;
 /// Fastest speed (m/s) at which the solve pushes apart bodies that already
 /// overlapped at their previous poses (Box2D's contact push speed is 3 m/s);
 /// joints close an old gap no faster (`MAX_DEPENETRATION_SPEED` in the
@@ -608,8 +613,8 @@ impl World {
     pub fn step_with(&mut self, dts: &[f32]) -> Result<(), Error> {
         self.gpu.check()?;
         for (k, &dt) in dts.iter().enumerate() {
-            if !(dt.is_finite() && dt > 0.0) {
-                return Err(Error::Input(format!("dt[{k}]: must be a positive finite number of seconds, got {dt}")));
+            if !(dt.is_finite() && dt >= MIN_DT) {
+                return Err(Error::Input(format!("dt[{k}]: must be a finite number of seconds >= {MIN_DT:e}, got {dt}")));
             }
         }
         let substeps = self.settings.substeps as usize;

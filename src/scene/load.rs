@@ -302,6 +302,9 @@ impl RawBody {
             None => IDENTITY_ORIENTATION,
         };
 
+        // where a mass worked out from the density is blamed (the density
+        // given, or the shape's size when none was)
+        let mut blame = None;
         let mass = match (self.density, self.mass) {
             (Some(density), Some(mass)) => {
                 return Err(SceneError::invalid(
@@ -315,13 +318,14 @@ impl RawBody {
                 let density = density.unwrap_or(DEFAULT_DENSITY);
                 check_positive(density, &density_path)?;
                 check_shape(&shape, &shape_path)?;
-                // the density given, or the shape's size when none was
-                let blame = if self.density.is_some() { density_path } else { shape_path.clone() };
-                mass_from_density(density, &shape, &blame)?
+                let path = if self.density.is_some() { density_path } else { shape_path.clone() };
+                let mass = mass_from_density(density, &shape, &path)?;
+                blame = Some(path);
+                mass
             }
         };
 
-        Ok(Body {
+        let body = Body {
             shape,
             position,
             orientation,
@@ -331,7 +335,13 @@ impl RawBody {
             fixed: self.fixed.unwrap_or(false),
             restitution: self.restitution,
             friction: self.friction,
-        })
+        };
+        // a density so small that the inverse mass overflows is the
+        // density's fault, not a mass the user never gave
+        if let (Some(path), Some(why)) = (blame, inverse_problem(&body)) {
+            return Err(SceneError::invalid(path, format!("density {}: {why}", show(self.density.unwrap_or(DEFAULT_DENSITY)))));
+        }
+        Ok(body)
     }
 }
 

@@ -177,6 +177,9 @@ fn errors_name_the_field() {
             r#"{"bodies": [{"shape": {"type": "sphere", "radius": 1e30}, "position": [0, 3, 0]}]}"#.to_string(),
             "bodies[0].shape: density 1000 kg/m³ times volume inf m³",
         ),
+        // a mass f32 cannot invert, from the density the user gave
+        (body(r#", "density": 1e-44"#), "bodies[1].density: density 1e-44: mass "),
+        (body(r#", "mass": 1e-39"#), "bodies[1].mass: mass 1e-39 kg with this shape gives inverse mass inf"),
         (body(r#", "fixed": 1"#), "bodies[1].fixed: invalid type"),
         (
             r#"{"bodies": [{"shape": {"type": "sphere", "radius": 1}, "position": [0, 3, 0]}],
@@ -185,6 +188,7 @@ fn errors_name_the_field() {
             "joints[0].anchors[1]: lies 1.0000e7 m from the origin; at most 1e6 m",
         ),
         (r#"{"settings": {"dt": -0.1}}"#.to_string(), "settings.dt: must be positive, got -0.1"),
+        (r#"{"settings": {"dt": 1e-9}}"#.to_string(), "settings.dt: must be at least 1e-6 s, got 1e-9"),
         (r#"{"settings": {"iterations": 0}}"#.to_string(), "settings.iterations: must be between 1 and 256, got 0"),
         (r#"{"settings": {"iterations": -3}}"#.to_string(), "settings.iterations: invalid value"),
         (r#"{"settings": {"substeps": 65}}"#.to_string(), "settings.substeps: must be between 1 and 64, got 65"),

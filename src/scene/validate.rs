@@ -30,6 +30,9 @@ impl Scene {
 
 pub(super) fn validate_settings(s: &Settings) -> Result<(), SceneError> {
     check_positive(s.dt, "settings.dt")?;
+    if s.dt < crate::world::MIN_DT {
+        return Err(SceneError::invalid("settings.dt", dt_too_short(s.dt)));
+    }
     check_all_finite(&s.gravity, "settings.gravity")?;
     if !(1..=MAX_ITERATIONS).contains(&s.iterations) {
         return Err(SceneError::invalid(
@@ -59,6 +62,16 @@ pub(super) fn validate_settings(s: &Settings) -> Result<(), SceneError> {
 /// rest 6 mm inside the ground at dt 0.2 s, 39 mm at 0.5 s and 156 mm at
 /// 1 s (3 substeps, 3 sweeps, c_r 0.5), as the formula says. The limit is a
 /// tenth of the smallest moving body's bounding radius.
+/// Why a step of `dt` s is too short (`world::MIN_DT`).
+pub fn dt_too_short(dt: f32) -> String {
+    format!(
+        "must be at least {:e} s, got {}: over shorter steps the rounding of the poses reads as speed, and the step stops \
+         bodies at rest as thrown",
+        crate::world::MIN_DT,
+        show(dt)
+    )
+}
+
 pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError> {
     let Some(smallest) = bodies.iter().filter(|b| !b.fixed).map(|b| b.bounding_radius()).reduce(f32::min) else {
         return Ok(());
@@ -143,25 +156,31 @@ pub(super) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Res
     if let Some(friction) = body.friction {
         check_friction(friction, &format!("{path}.friction"))?;
     }
-    // A valid but extreme mass and size can still overflow f32 in the
-    // inverse mass or inertia; the solver needs those finite and positive.
-    if !body.fixed {
-        let inverse_mass = body.inverse_mass();
-        let inverse_inertia = body.inverse_inertia();
-        let usable = |x: f32| x.is_finite() && x > 0.0;
-        if !usable(inverse_mass) || !inverse_inertia.iter().all(|&x| usable(x)) {
-            return Err(SceneError::invalid(
-                format!("{path}.mass"),
-                format!(
-                    "mass {} kg with this shape gives inverse mass {} and inverse inertia {:?}, which are not positive finite numbers",
-                    show(body.mass),
-                    show(inverse_mass),
-                    inverse_inertia
-                ),
-            ));
-        }
+    if let Some(why) = inverse_problem(body) {
+        return Err(SceneError::invalid(format!("{path}.mass"), why));
     }
     Ok(())
+}
+
+/// Why a movable body's mass and size are unusable, if they are: a valid
+/// but extreme mass and size can still overflow f32 in the inverse mass or
+/// inertia, and the solver needs those finite and positive.
+pub(super) fn inverse_problem(body: &Body) -> Option<String> {
+    if body.fixed {
+        return None;
+    }
+    let inverse_mass = body.inverse_mass();
+    let inverse_inertia = body.inverse_inertia();
+    let usable = |x: f32| x.is_finite() && x > 0.0;
+    if usable(inverse_mass) && inverse_inertia.iter().all(|&x| usable(x)) {
+        return None;
+    }
+    Some(format!(
+        "mass {} kg with this shape gives inverse mass {} and inverse inertia {:?}, which are not positive finite numbers",
+        show(body.mass),
+        show(inverse_mass),
+        inverse_inertia
+    ))
 }
 
 pub(super) fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Result<(), SceneError> {

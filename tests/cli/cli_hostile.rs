@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-use crate::common::{no_adapter, temp_path};
+use crate::common::{no_adapter, temp_path, verlet};
 use verlet::scene::Scene;
 use verlet::scenes;
 
@@ -535,6 +535,29 @@ fn negative_numbers_are_refused_saying_what_the_flag_takes() {
         &["run", "--builtin", "drop", "--steps", "-1"],
         &["--steps: must be a non-negative whole number, got -1"],
     );
+}
+
+#[test]
+fn steps_too_short_for_the_poses_are_refused_naming_the_field() {
+    // 1e-9 s ran a step and stopped a pile at rest as thrown by the solver;
+    // 1e-45 as non-finite
+    for dt in ["1e-45", "1e-9", "9.9e-7"] {
+        assert_refused_quickly(&["run", "--builtin", "pile", "--steps", "1", "--dt", dt], &["--dt", "at least 1e-6 s", dt]);
+    }
+    let (dir, scene, _) = workdir("short-dt");
+    let mut short = scenes::drop();
+    short.settings.dt = 1e-9;
+    std::fs::write(&scene, short.to_json()).unwrap();
+    assert_refused_quickly(&["run", s(&scene), "--steps", "1"], &["settings.dt", "at least 1e-6 s"]);
+    // the shortest step runs, and the summary shows it
+    let out = verlet(&["run", "--builtin", "drop", "--steps", "2", "--dt", "1e-6"]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("2 steps of 1.000e-6 s (2.000e-6 s simulated)"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
