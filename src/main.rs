@@ -528,11 +528,16 @@ fn run(args: RunArgs) -> Result<(), Error> {
     };
     let wall = started.elapsed();
     let frames_written = recorder.frames_written;
-    recorder.finish(args.every, scene.settings.dt)?;
-    if let Some(path) = &args.state_out {
-        output::write_file(path, &output::state_json(world.step_count(), world.time(), &bodies))
-            .map_err(|e| Error::Input(format!("--state-out: {e}")))?;
+    let state_json = args.state_out.as_ref().map(|_| output::state_json(world.step_count(), world.time(), &bodies));
+    let mut writes = recorder.finish(&args, scene.settings.dt);
+    if let (Some(path), Some(text)) = (&args.state_out, &state_json) {
+        writes.push((
+            "--state-out",
+            path,
+            Box::new(move || output::write_file(path, text).map_err(|e| Error::Input(format!("--state-out: {e}")))),
+        ));
     }
+    output::write_each(writes)?;
     let ms = wall.as_secs_f64() * 1e3 / args.steps.max(1) as f64;
     outln!(
         "{} bodies, {} steps of {} s ({} s simulated) on {}",
@@ -756,24 +761,39 @@ impl Recorder {
         Ok(())
     }
 
-    /// Commits the trace and writes the GIF and the contact sheet.
-    fn finish(self, every: u64, dt: f32) -> Result<(), Error> {
-        if let Some((_, file)) = self.trace {
-            file.commit().map_err(|e| Error::Input(format!("--trace: {e}")))?;
+    /// What commits the trace and writes the GIF and the contact sheet, at
+    /// the paths `args` gives (`output::write_each` runs them, each whatever
+    /// became of the others).
+    fn finish<'a>(self, args: &'a RunArgs, dt: f32) -> Vec<output::EndWrite<'a>> {
+        let mut writes: Vec<output::EndWrite<'a>> = Vec::new();
+        if let (Some((_, file)), Some(path)) = (self.trace, args.trace.as_deref()) {
+            writes.push(("--trace", path, Box::new(move || file.commit().map_err(|e| Error::Input(format!("--trace: {e}"))))));
         }
-        if let Some((path, reel)) = self.gif {
+        if let (Some((_, reel)), Some(path)) = (self.gif, args.gif.as_deref()) {
             // real time where GIF allows: browsers slow delays under 20 ms to 100 ms
-            let ms = (every * reel.stride) as f64 * dt as f64 * 1e3;
+            let ms = (args.every * reel.stride) as f64 * dt as f64 * 1e3;
             let frame_ms = ms.round().clamp(20.0, 10_000.0) as u32;
-            render::write_gif(&reel.finish(), frame_ms, &path).map_err(|e| Error::Input(format!("--gif: {e}")))?;
+            writes.push((
+                "--gif",
+                path,
+                Box::new(move || {
+                    render::write_gif(&reel.finish(), frame_ms, path).map_err(|e| Error::Input(format!("--gif: {e}")))
+                }),
+            ));
         }
-        if let Some((path, reel)) = self.sheet {
-            let tiles = reel.finish();
-            let columns = (tiles.len() as f64).sqrt().ceil() as u32;
-            render::write_png(&render::contact_sheet(&tiles, columns, None)?, &path)
-                .map_err(|e| Error::Input(format!("--contact-sheet: {e}")))?;
+        if let (Some((_, reel)), Some(path)) = (self.sheet, args.contact_sheet.as_deref()) {
+            writes.push((
+                "--contact-sheet",
+                path,
+                Box::new(move || {
+                    let tiles = reel.finish();
+                    let columns = (tiles.len() as f64).sqrt().ceil() as u32;
+                    render::write_png(&render::contact_sheet(&tiles, columns, None)?, path)
+                        .map_err(|e| Error::Input(format!("--contact-sheet: {e}")))
+                }),
+            ));
         }
-        Ok(())
+        writes
     }
 
     /// After a failed run: keeps the trace rows recorded so far beside the

@@ -301,6 +301,36 @@ pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Re
     Ok(())
 }
 
+/// One output of a run to write at its end: its flag, its path, and what
+/// writes it.
+pub type EndWrite<'a> = (&'a str, &'a Path, Box<dyn FnOnce() -> Result<(), Error> + 'a>);
+
+/// Writes each of a run's outputs whatever became of the others: a GIF that
+/// could not be written once left `--state-out` unwritten too, unsaid. On a
+/// failure the error is the first one's, and says which outputs were
+/// written all the same and which others failed.
+pub fn write_each(writes: Vec<EndWrite<'_>>) -> Result<(), Error> {
+    let mut failed: Vec<String> = Vec::new();
+    let mut written: Vec<String> = Vec::new();
+    for (flag, path, write) in writes {
+        match write() {
+            Ok(()) => written.push(format!("{flag} {}", path.display())),
+            Err(e) => failed.push(e.to_string()),
+        }
+    }
+    let Some((first, others)) = failed.split_first() else {
+        return Ok(());
+    };
+    let mut message = first.clone();
+    if !written.is_empty() {
+        message.push_str(&format!(" (written all the same: {})", written.join(", ")));
+    }
+    for other in others {
+        message.push_str(&format!("; and {other}"));
+    }
+    Err(Error::Input(message))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -318,6 +348,38 @@ mod tests {
             std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
         names.sort();
         names
+    }
+
+    #[test]
+    fn every_output_is_written_whatever_became_of_the_others() {
+        let dir = scratch("write-each");
+        // a GIF and a sheet whose destinations turned into directories with
+        // a file in them during the run: their renames fail
+        let (gif, sheet, state) = (dir.join("run.gif"), dir.join("sheet.png"), dir.join("state.json"));
+        for blocked in [&gif, &sheet] {
+            std::fs::create_dir(blocked).unwrap();
+            std::fs::write(blocked.join("inside"), b"x").unwrap();
+        }
+        let write = |flag: &'static str, path: &'static Path| -> Box<dyn FnOnce() -> Result<(), Error>> {
+            Box::new(move || write_file(path, "{}").map_err(|e| Error::Input(format!("{flag}: {e}"))))
+        };
+        let leak = |p: &PathBuf| -> &'static Path { Box::leak(p.clone().into_boxed_path()) };
+        let (gif_at, sheet_at, state_at) = (leak(&gif), leak(&sheet), leak(&state));
+        let err = write_each(vec![
+            ("--gif", gif_at, write("--gif", gif_at)),
+            ("--state-out", state_at, write("--state-out", state_at)),
+            ("--contact-sheet", sheet_at, write("--contact-sheet", sheet_at)),
+        ])
+        .unwrap_err()
+        .to_string();
+        assert!(err.starts_with("--gif: "), "{err}");
+        assert!(err.contains(&format!("(written all the same: --state-out {})", state.display())), "{err}");
+        assert!(err.contains("; and --contact-sheet: "), "{err}");
+        assert_eq!(std::fs::read_to_string(&state).unwrap(), "{}");
+        assert_eq!(listing(&dir), ["run.gif", "sheet.png", "state.json"], "no temporary file left");
+        // all written: no error
+        assert!(write_each(vec![("--state-out", state_at, write("--state-out", state_at))]).is_ok());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
