@@ -418,6 +418,21 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// The track's events that acted before the step a fault was found in or
+/// the one before (where the state may have gone bad), named for the
+/// fault's message: an impulse of 1e30 N s is the input's doing, not the
+/// solver's.
+fn inputs_before(track: Option<&Track>, fault: &verlet::world::Fault, world: &World) -> String {
+    let Some(track) = track else { return String::new() };
+    let acting = track.acting_before(fault.step.saturating_sub(1)..=fault.step, world.settings().dt);
+    if acting.is_empty() {
+        return String::new();
+    }
+    let named: Vec<String> = acting.iter().take(3).map(|(k, name)| format!("events[{k}] ({name})")).collect();
+    let more = if acting.len() > 3 { format!(" and {} more", acting.len() - 3) } else { String::new() };
+    format!("; the input track's {}{more} acted just before", named.join(", "))
+}
+
 /// `s` seconds with `places` decimals, or in scientific notation where
 /// those would show nothing (a step of 1e-6 s is not "0.00000 s").
 fn seconds(s: f64, places: usize) -> String {
@@ -515,7 +530,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
     // readback; the run reads the flag here once (and read_state, which
     // every trace row calls, reads it too) and fails naming body and step.
     let outcome = stepped.and_then(|stage_ms| match world.faults()? {
-        Some(fault) => Err(Error::Diverged(fault.to_string())),
+        Some(fault) => Err(Error::Diverged(format!("{fault}{}", inputs_before(track.as_ref(), &fault, &world)))),
         None => Ok((stage_ms, world.read_state()?)),
     });
     let (stage_ms, bodies) = match outcome {

@@ -47,7 +47,7 @@ use std::path::Path;
 use serde::Deserialize;
 
 use crate::load_error::FileKind;
-use crate::scene::{path_string, Obj};
+use crate::scene::{path_string, position_problem, speed_problem, Obj};
 use crate::world::input::{BodyInput, Point, Wind};
 use crate::{Error, World};
 
@@ -237,6 +237,24 @@ impl Track {
         }
     }
 
+    /// The events (their indices in the file, and their actions' names)
+    /// that act before any step of `steps`, for steps of `dt`: what to name
+    /// when a body is found absurd there.
+    pub fn acting_before(&self, steps: std::ops::RangeInclusive<u64>, dt: f32) -> Vec<(usize, &'static str)> {
+        let mut acting: Vec<(usize, &'static str)> = self
+            .events
+            .iter()
+            .zip(&self.origin)
+            .filter(|(e, _)| {
+                let (first, end) = Track::steps(e, dt);
+                first <= *steps.end() && end > *steps.start()
+            })
+            .map(|(e, &k)| (k, e.action.name()))
+            .collect();
+        acting.sort();
+        acting
+    }
+
     /// The first step at or after `step` before which this track does
     /// anything, for steps of `dt`.
     pub fn next_input_step(&self, step: u64, dt: f32) -> Option<u64> {
@@ -366,6 +384,7 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
             finite(impulse, &at("impulse"))?;
             if let Some(p) = point {
                 finite(p, &at("point"))?;
+                sane(position_problem(*p), &at("point"))?;
             }
         }
         Action::Explode { centre, strength, radius, falloff } => {
@@ -376,6 +395,7 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
         }
         Action::SetPose { position, orientation, .. } => {
             finite(position, &at("position"))?;
+            sane(position_problem(*position), &at("position"))?;
             finite(orientation, &at("orientation"))?;
             let norm = orientation.iter().map(|&v| (v as f64) * (v as f64)).sum::<f64>().sqrt();
             if norm < 1e-6 {
@@ -384,6 +404,7 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
         }
         Action::SetVelocity { linear, angular, .. } => {
             finite(linear, &at("linear"))?;
+            sane(speed_problem(*linear), &at("linear"))?;
             finite(angular, &at("angular"))?;
             // the turn per substep is checked when applied, against the world's dt
             if let Some(why) = crate::scene::spin_problem(*angular, 0.0) {
@@ -397,6 +418,8 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
         }
         Action::Wind { wind, duration } => {
             finite(&wind.velocity, &at("velocity"))?;
+            // the drag pulls a body toward the wind's velocity
+            sane(speed_problem(wind.velocity), &at("velocity"))?;
             at_least(wind.air_density, &at("air_density"), 0.0, true)?;
             at_least(wind.drag, &at("drag"), 0.0, true)?;
             at_least(wind.gust, &at("gust"), 0.0, true)?;
@@ -405,6 +428,11 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
         }
     }
     Ok(())
+}
+
+/// Refuses what `problem` found wrong (scene::position_problem, ...).
+fn sane(problem: Option<String>, path: &str) -> Result<(), TrackError> {
+    problem.map_or(Ok(()), |why| Err(TrackError::invalid(path, why)))
 }
 
 fn finite(values: &[f32], path: &str) -> Result<(), TrackError> {

@@ -101,6 +101,29 @@ pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError
     ))
 }
 
+fn length(v: [f32; 3]) -> f64 {
+    v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt()
+}
+
+/// Why a body placed at `p` (m) is absurd, if it is: farther than
+/// `world::MAX_DISTANCE` from the origin, where the step stops it as a fault.
+pub fn position_problem(p: [f32; 3]) -> Option<String> {
+    use crate::world::MAX_DISTANCE;
+    let distance = length(p);
+    (distance > MAX_DISTANCE as f64).then(|| {
+        format!("lies {distance:.4e} m from the origin; at most {MAX_DISTANCE:e} m is sane (the step stops a body beyond it)")
+    })
+}
+
+/// Why a body moving at `v` (m/s) is absurd, if it is: faster than
+/// `world::MAX_SPEED`, where the step stops it as a fault.
+pub fn speed_problem(v: [f32; 3]) -> Option<String> {
+    use crate::world::MAX_SPEED;
+    let speed = length(v);
+    (speed > MAX_SPEED as f64)
+        .then(|| format!("moves at {speed:.4e} m/s; at most {MAX_SPEED:e} m/s is sane (the step stops a faster body)"))
+}
+
 /// Why an angular velocity `w` (rad/s) is absurd for substeps of `h` s (0:
 /// any), if it is: faster than `world::MAX_SPIN`, or turning more than
 /// `world::MAX_TURN` in one substep, which a pose pair cannot hold (the
@@ -128,22 +151,12 @@ pub(super) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Res
     check_all_finite(&body.linear_velocity, &format!("{path}.linear_velocity"))?;
     check_all_finite(&body.angular_velocity, &format!("{path}.angular_velocity"))?;
     // what the step would stop at once as a numerical fault (integrate.wgsl)
-    use crate::world::{MAX_DISTANCE, MAX_SPEED};
-    let length = |v: [f32; 3]| v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
-    let distance = length(body.position);
-    if distance > MAX_DISTANCE as f64 {
-        return Err(SceneError::invalid(
-            format!("{path}.position"),
-            format!("lies {distance:.4e} m from the origin; at most {MAX_DISTANCE:e} m is sane (the step stops a body beyond it)"),
-        ));
+    if let Some(why) = position_problem(body.position) {
+        return Err(SceneError::invalid(format!("{path}.position"), why));
     }
     if !body.fixed {
-        let speed = length(body.linear_velocity);
-        if speed > MAX_SPEED as f64 {
-            return Err(SceneError::invalid(
-                format!("{path}.linear_velocity"),
-                format!("moves at {speed:.4e} m/s; at most {MAX_SPEED:e} m/s is sane (the step stops a faster body)"),
-            ));
+        if let Some(why) = speed_problem(body.linear_velocity) {
+            return Err(SceneError::invalid(format!("{path}.linear_velocity"), why));
         }
         if let Some(why) = spin_problem(body.angular_velocity, settings.dt / settings.substeps as f32) {
             return Err(SceneError::invalid(format!("{path}.angular_velocity"), why));
@@ -213,7 +226,7 @@ pub(super) fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Re
         // a world point, or an offset from the body's centre: beyond what a
         // body may reach (it would be stopped as a fault there)
         use crate::world::MAX_DISTANCE;
-        let distance = anchor.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+        let distance = length(*anchor);
         if distance > MAX_DISTANCE as f64 {
             let from = if joint.bodies[k] == WORLD { "the origin" } else { "its body's centre" };
             return Err(SceneError::invalid(at, format!("lies {distance:.4e} m from {from}; at most {MAX_DISTANCE:e} m is sane")));

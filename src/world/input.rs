@@ -154,6 +154,8 @@ impl Wind {
 
     fn validate(&self) -> Result<(), Error> {
         check_finite("wind.velocity", &self.velocity)?;
+        // the drag pulls a body toward the wind's velocity
+        check_sane("wind.velocity", crate::scene::speed_problem(self.velocity))?;
         for (name, v) in [("wind.air_density", self.air_density), ("wind.drag", self.drag), ("wind.gust", self.gust)] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::Input(format!("{name}: must be a finite number >= 0, got {v}")));
@@ -235,6 +237,11 @@ fn check_finite(name: &str, values: &[f32]) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// Refuses what `problem` found wrong (scene::position_problem, ...).
+fn check_sane(name: &str, problem: Option<String>) -> Result<(), Error> {
+    problem.map_or(Ok(()), |why| Err(Error::Input(format!("{name}: {why}"))))
 }
 
 impl World {
@@ -373,11 +380,13 @@ impl World {
                         Point::Local(p) => (2.0, p),
                     };
                     check_finite(&at("point"), &p)?;
+                    check_sane(&at("point"), crate::scene::position_problem(p))?;
                     op.a[3] = mode;
                     op.b = [p[0], p[1], p[2], 0.0];
                 }
                 BodyInput::Pose { position, orientation, .. } => {
                     check_finite(&at("position"), &position)?;
+                    check_sane(&at("position"), crate::scene::position_problem(position))?;
                     check_finite(&at("orientation"), &orientation)?;
                     let q = orientation.map(|v| v as f64);
                     let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -390,6 +399,7 @@ impl World {
                 }
                 BodyInput::Velocity { linear, angular, .. } => {
                     check_finite(&at("linear"), &linear)?;
+                    check_sane(&at("linear"), crate::scene::speed_problem(linear))?;
                     check_finite(&at("angular"), &angular)?;
                     let substep = self.settings.dt / self.settings.substeps as f32;
                     if let Some(why) = crate::scene::spin_problem(angular, substep) {

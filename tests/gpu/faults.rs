@@ -87,9 +87,12 @@ fn absurd_initial_velocity_is_flagged_and_the_others_are_untouched() {
         Err(e) => assert!(e.to_string().contains("bodies[2].linear_velocity"), "{e}"),
         Ok(_) => panic!("the loader accepted 1e5 m/s"),
     }
-    // an input may still ask for it before the first step
+    // so is an input that asks for it (set_velocity), but an impulse may
+    // still make it before the first step (a unit box weighs 1000 kg)
     let Some(mut world) = crate::common::world(&row()) else { return };
-    world.set_velocity(2, [1e5, 0.0, 0.0], [0.0; 3]).unwrap();
+    let err = world.set_velocity(2, [1e5, 0.0, 0.0], [0.0; 3]).unwrap_err().to_string();
+    assert!(err.starts_with("linear: moves at 1.0000e5 m/s"), "{err}");
+    world.apply_impulse(2, [1e8, 0.0, 0.0], None).unwrap();
     let mut clean = crate::common::world(&row()).unwrap();
     assert_eq!(world.faults().unwrap(), None, "no fault before any step");
     world.step(120).unwrap();
@@ -125,10 +128,11 @@ fn the_first_fault_is_kept_with_its_own_step() {
     world.step(10).unwrap();
     assert_eq!(world.faults().unwrap(), None);
     // two bodies go wrong before step 10, a lower one before step 20
-    world.set_velocity(4, [0.0, 2e4, 0.0], [0.0; 3]).unwrap();
-    world.set_velocity(3, [0.0, 0.0, -3e4], [0.0; 3]).unwrap();
+    // (impulses on unit boxes of 1000 kg)
+    world.apply_impulse(4, [0.0, 2e7, 0.0], None).unwrap();
+    world.apply_impulse(3, [0.0, 0.0, -3e7], None).unwrap();
     world.step(10).unwrap();
-    world.set_velocity(0, [5e4, 0.0, 0.0], [0.0; 3]).unwrap();
+    world.apply_impulse(0, [5e7, 0.0, 0.0], None).unwrap();
     world.step(10).unwrap();
     let fault = world.faults().unwrap().expect("flagged");
     assert_eq!(fault, Fault { body: 3, step: 10, kind: FaultKind::TooFast }, "the lowest body of the first step");
@@ -140,7 +144,14 @@ fn the_first_fault_is_kept_with_its_own_step() {
     world.clear_faults().unwrap();
     world.step(5).unwrap();
     assert_eq!(world.faults().unwrap(), None);
-    world.set_pose(1, [2e6, 0.5, 0.0], [0.0, 0.0, 0.0, 1.0]).unwrap();
+    // an input may not put a body there (set_pose), so it is put there in
+    // the state buffer itself
+    let err = world.set_pose(1, [2e6, 0.5, 0.0], [0.0, 0.0, 0.0, 1.0]).unwrap_err().to_string();
+    assert!(err.starts_with("position: lies 2.0000e6 m from the origin"), "{err}");
+    let mut far = raw(&world)[1];
+    far.pos[0] = 2e6;
+    let at = std::mem::size_of::<BodyState>() as u64;
+    world.gpu().queue.write_buffer(world.current_state_buffer(), at, bytemuck::bytes_of(&far));
     world.step(5).unwrap();
     let fault = world.faults().unwrap().expect("flagged");
     assert_eq!(fault, Fault { body: 1, step: 35, kind: FaultKind::TooFar });
@@ -221,8 +232,9 @@ fn the_command_line_fails_naming_body_and_step() {
     scene.bodies[1].linear_velocity = [0.0, 0.0, 2e5];
     let bad = write(&dir, "bad.json", &scene.to_json());
     let clean = write(&dir, "clean.json", &row().to_json());
-    // body 4 thrown at 1e5 m/s by a track before step 30 (t = 0.5 s at dt = 1/60)
-    let track = write(&dir, "throw.json", r#"{"events": [{"t": 0.5, "set_velocity": {"body": 4, "linear": [1e5, 0, 0]}}]}"#);
+    // body 4 (1000 kg) thrown at 1e5 m/s by a track before step 30 (t = 0.5
+    // s at dt = 1/60)
+    let track = write(&dir, "throw.json", r#"{"events": [{"t": 0.5, "impulse": {"body": 4, "impulse": [1e8, 0, 0]}}]}"#);
     let run = |args: &[&std::ffi::OsStr]| {
         let out = Command::new(env!("CARGO_BIN_EXE_verlet")).arg("run").args(args).output().expect("verlet runs");
         (out.status, String::from_utf8_lossy(&out.stderr).into_owned())
@@ -236,6 +248,7 @@ fn the_command_line_fails_naming_body_and_step() {
     let (status, stderr) = run(&[clean.as_os_str(), "--steps".as_ref(), "60".as_ref(), "--input".as_ref(), track.as_os_str()]);
     assert!(!status.success(), "a faulted run must fail");
     assert!(stderr.contains("body 4 became absurd") && stderr.contains("at step 30"), "{stderr}");
+    assert!(stderr.contains("the input track's events[0] (impulse) acted just before"), "{stderr}");
 
     // with a trace, the row read after the fault stops the run
     let trace = dir.join("trace.csv");

@@ -88,6 +88,23 @@ const BAD: &[(&str, &str)] = &[
         r#"{"events": [{"t": 1, "set_pose": {"body": 0, "position": [0,0,0], "orientation": [0,0,0,0]}}]}"#,
         "events[0].set_pose.orientation: must be a non-zero quaternion",
     ),
+    // what the step would stop at once as a fault (the scene's own limits)
+    (
+        r#"{"events": [{"t": 1, "set_pose": {"body": 0, "position": [0,1e7,0], "orientation": [0,0,0,1]}}]}"#,
+        "events[0].set_pose.position: lies 1.0000e7 m from the origin; at most 1e6 m",
+    ),
+    (
+        r#"{"events": [{"t": 1, "impulse": {"body": 0, "impulse": [0,1,0], "point": [1e30,0,0]}}]}"#,
+        "events[0].impulse.point: lies 1.0000e30 m from the origin",
+    ),
+    (
+        r#"{"events": [{"t": 1, "set_velocity": {"body": 0, "linear": [2e4,0,0]}}]}"#,
+        "events[0].set_velocity.linear: moves at 2.0000e4 m/s; at most 1e4 m/s",
+    ),
+    (
+        r#"{"events": [{"t": 1, "wind": {"velocity": [0,0,1e30], "duration": 1}}]}"#,
+        "events[0].wind.velocity: moves at 1.0000e30 m/s",
+    ),
     (r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": "yes"}}]}"#, "events[0].fixed.fixed: invalid type"),
     (r#"{"events": [{"t": 1, "fixed": {"body": 0, "fixed": false, "mass": 0}}]}"#, "events[0].fixed.mass: must be > 0"),
     (r#"{"events": [{"t": 1, "wind": {"velocity": [1,0,0]}}]}"#, "events[0].wind.duration: is required but missing"),

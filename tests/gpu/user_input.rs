@@ -4,7 +4,7 @@
 use crate::common::{quat, v3, world};
 use glam::{DQuat, DVec3, Quat};
 use verlet::scenes::{box_body, sphere_body};
-use verlet::world::input::{BodyInput, Point};
+use verlet::world::input::{BodyInput, Point, Wind};
 use verlet::{Body, Error, Scene, Settings, World};
 
 fn free_settings() -> Settings {
@@ -333,6 +333,11 @@ fn bad_arguments_are_input_errors_naming_the_argument() {
         (Box::new(|w| w.set_pose(0, [f32::NAN, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0])), "position[0]"),
         (Box::new(|w| w.set_pose(0, [0.0; 3], [0.0; 4])), "orientation"),
         (Box::new(|w| w.set_velocity(0, [0.0; 3], [0.0, f32::NEG_INFINITY, 0.0])), "angular[1]"),
+        // what the step would stop at once as a fault
+        (Box::new(|w| w.apply_impulse(0, [1.0; 3], Some([0.0, 2e6, 0.0]))), "point"),
+        (Box::new(|w| w.set_pose(0, [0.0, 0.0, -1e7], [0.0, 0.0, 0.0, 1.0])), "position"),
+        (Box::new(|w| w.set_velocity(0, [0.0, 1e5, 0.0], [0.0; 3])), "linear"),
+        (Box::new(|w| w.apply_wind(&Wind::steady([3e4, 0.0, 0.0]), 0.1)), "wind.velocity"),
         (Box::new(|w| w.explode([0.0, f32::NAN, 0.0], 1.0, 1.0, 1.0)), "centre[1]"),
         (Box::new(|w| w.explode([0.0; 3], f32::NAN, 1.0, 1.0)), "strength"),
         (Box::new(|w| w.explode([0.0; 3], 1.0, 0.0, 1.0)), "radius"),
