@@ -715,8 +715,9 @@ struct Recorder {
     /// succeeds ([`output::AtomicFile`]).
     trace: Option<(PathBuf, output::AtomicFile)>,
     frames_dir: Option<PathBuf>,
-    gif: Option<(PathBuf, Reel)>,
-    sheet: Option<(PathBuf, Reel)>,
+    /// The frames kept for `--gif` and `--contact-sheet`.
+    gif: Option<Reel>,
+    sheet: Option<Reel>,
     /// Made once the GPU is up, if any image is wanted.
     renderer: Option<Renderer>,
     frames_written: u64,
@@ -742,8 +743,8 @@ impl Recorder {
             std::fs::create_dir_all(dir)
                 .map_err(|e| Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display())))?;
         }
-        let gif = args.gif.as_ref().map(|path| (path.clone(), Reel::new(GIF_FRAMES, GIF_BOX)));
-        let sheet = args.contact_sheet.as_ref().map(|path| (path.clone(), Reel::new(SHEET_TILES, SHEET_BOX)));
+        let gif = args.gif.as_ref().map(|_| Reel::new(GIF_FRAMES, GIF_BOX));
+        let sheet = args.contact_sheet.as_ref().map(|_| Reel::new(SHEET_TILES, SHEET_BOX));
         Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer: None, frames_written: 0, last_step: None })
     }
 
@@ -768,7 +769,7 @@ impl Recorder {
                 render::write_png(&image, &path).map_err(|e| Error::Input(format!("--frames: {e}")))?;
             }
             self.frames_written += 1;
-            for (_, reel) in self.gif.iter_mut().chain(self.sheet.iter_mut()) {
+            for reel in self.gif.iter_mut().chain(self.sheet.iter_mut()) {
                 reel.push(&image);
             }
         }
@@ -784,7 +785,7 @@ impl Recorder {
         if let (Some((_, file)), Some(path)) = (self.trace, args.trace.as_deref()) {
             writes.push(("--trace", path, Box::new(move || file.commit().map_err(|e| Error::Input(format!("--trace: {e}"))))));
         }
-        if let (Some((_, reel)), Some(path)) = (self.gif, args.gif.as_deref()) {
+        if let (Some(reel), Some(path)) = (self.gif, args.gif.as_deref()) {
             // real time where GIF allows: browsers slow delays under 20 ms to 100 ms
             let ms = (args.every * reel.stride) as f64 * dt as f64 * 1e3;
             let frame_ms = ms.round().clamp(20.0, 10_000.0) as u32;
@@ -796,7 +797,7 @@ impl Recorder {
                 }),
             ));
         }
-        if let (Some((_, reel)), Some(path)) = (self.sheet, args.contact_sheet.as_deref()) {
+        if let (Some(reel), Some(path)) = (self.sheet, args.contact_sheet.as_deref()) {
             writes.push((
                 "--contact-sheet",
                 path,
