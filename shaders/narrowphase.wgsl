@@ -156,6 +156,18 @@ fn list_contact(i: u32, r: u32) {
     }
 }
 
+// Whether a joint joins body a to body b: one of a's joint ends has b for
+// partner. Asked here, once a pair, not in the pair walks (pairs.wgsl),
+// where the loop cost every candidate of every walk.
+fn joined(a: u32, b: u32) -> bool {
+    var found = false;
+    let end = joint_start[a + 1u];
+    for (var k = joint_start[a]; k < end; k = k + 1u) {
+        found = found || joint_refs[k].partner == b;
+    }
+    return found;
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let p = dispatch_index(gid, groups);
@@ -163,8 +175,9 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     let pr = pairs[p];
-    // ground pairs: narrowphase_ground
-    if (pr.b == GROUND) {
+    // ground pairs: narrowphase_ground; bodies joined by a joint do not
+    // collide (the joint holds them together where their shapes meet)
+    if (pr.b == GROUND || joined(pr.a, pr.b)) {
         return;
     }
     let a = shape_of(pr.a);

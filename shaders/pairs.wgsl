@@ -34,31 +34,17 @@
 // walks them all); a large body (kept out of the grid) owns only its pairs
 // with large bodies of higher index, so it never walks the cells; every
 // body owns its pair with the ground. A fast body (`is_fast`) walks every
-// cell within its reach instead, and owns its pairs with all it finds
-// there but the faster bodies (`outranks`); no other walk takes a pair
-// with it. A pair is wanted when the two bodies' bounds come within the
-// margin, they are not joined, and one of them moves: not fixed and awake,
-// or asleep but woken by the last step's narrowphase (pair_meta's MOVES).
-// Only the owner decides, alike in both walks (the test reads only what
-// these passes do not write).
+// cell within its reach instead (or the whole grid, where that is
+// shorter), and owns its pairs with all it finds there but the faster
+// bodies (`outranks`); no other walk takes a pair with it. A pair is wanted when the two bodies' bounds come within the
+// margin and one of them moves: not fixed and awake, or asleep but woken
+// by the last step's narrowphase (pair_meta's MOVES). Only the owner
+// decides, alike in both walks (the test reads only what these passes do
+// not write). Bodies joined by a joint are listed too, and the narrowphase
+// drops their pair (see `visit_places`).
 
 // CONTACT_MARGIN (shared with Rust, src/world.rs): the gap (m) kept as
 // contact whatever the speed.
-
-// Bodies joined by a joint do not collide: the joint holds them together
-// where their shapes meet. Whether the walker is joined to body j: one of
-// its own joint ends (read once, in `walk`) has j for partner. Reading the
-// lower index's ends instead made every candidate load two joint starts:
-// a fifth of pairs_count in a pile with no joints at all.
-fn joined_to_walker(j: u32) -> bool {
-    for (var k = walker.joints.x; k < walker.joints.y; k = k + 1u) {
-        trips = trips + 1u;
-        if (joint_refs[k].partner == j) {
-            return true;
-        }
-    }
-    return false;
-}
 
 // Gap (m) within which pair (lo, hi) gets contacts: the fixed margin plus
 // how much nearer they may come within the coming step: their relative
@@ -84,25 +70,18 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
 
 // Whether the walking body and body j (not the walker) form a candidate
 // pair: one of them moves, their bounds (bounding spheres and world boxes,
-// grown by their reach) come within CONTACT_MARGIN, and they are not
-// joined. The spheres cut the corners of the boxes: in a 10k pile of
+// grown by their reach) come within CONTACT_MARGIN. The spheres cut the
+// corners of the boxes: in a 10k pile of
 // tumbling cubes they cut the candidate pairs of the busiest step from
 // 81.9k to 44.6k, and by 8-17% once the pile has landed. (Every sum here is
 // of one term of each body, so it is the same bits whichever body walks.)
-// `wanted_bounds` is all but the joints, on j's centre, bounds and moves
-// as given (from cell_bounds, or from state_in and pair_meta: the same
-// values).
+// It takes j's centre, bounds and moves as given (from cell_bounds, or
+// from state_in and pair_meta: the same values).
 fn wanted_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u32) -> bool {
-    if (!walker.moves && moves_j != MOVES) {
-        return false;
-    }
     let d = walker.pos - pos_j;
     let spheres = walker.bound + bound_j + CONTACT_MARGIN;
-    if (dot(d, d) > spheres * spheres) {
-        return false;
-    }
     let apart = abs(d) - walker.extent - extent_j;
-    return all(apart <= vec3<f32>(CONTACT_MARGIN));
+    return (walker.moves || moves_j == MOVES) && dot(d, d) <= spheres * spheres && all(apart <= vec3<f32>(CONTACT_MARGIN));
 }
 
 // Whether body i is near enough the ground for a ground pair.
@@ -125,13 +104,12 @@ fn rings_of(size: f32) -> u32 {
     return u32(ceil(clamp((2.0 * size + CONTACT_MARGIN) / params.cell_size * 1.001, 1.0, MAX_RINGS)));
 }
 
-// Beyond this many rings a fast walker visits every bucket (the grid has
+// Beyond this many rings a fast walker takes the whole grid (the grid has
 // fewer than (2 MAX_RINGS + 1)^3).
 const MAX_RINGS: f32 = 500.0;
 
 // The walking body, read once: its index, centre, bounds (and the box's
-// size), whether it moves, whether it is fast and where its joint ends lie
-// in joint_refs (start, end).
+// size), whether it moves and whether it is fast.
 struct Walker {
     index: u32,
     pos: vec3<f32>,
@@ -140,7 +118,6 @@ struct Walker {
     size: f32,
     moves: bool,
     fast: bool,
-    joints: vec2<u32>,
 }
 
 // The walk's state: who walks, whether it writes (pairs_write) or counts
@@ -150,12 +127,13 @@ var<private> walker: Walker;
 var<private> writing: bool;
 var<private> room_start: u32;
 var<private> owned: u32;
-// The walk's loop trips so far (cells, candidates, large bodies, joint
-// ends). Where the driver ends an invocation's loops past LOOP_TRIPS
-// (lavapipe: 65535, summed over the 8 invocations it runs side by side), a
-// walk of more than an eighth of that may have been cut short, silently: a
-// fast body's walk in a large grid (every bucket), or a body with
-// thousands of joints. `note_long_walk` says so in status[20].
+// The walk's loop trips so far, as the driver counts them: each trip of
+// each loop (cells, places, large bodies), and the trip that ends each
+// loop. Where the driver ends an invocation's loops once they reach
+// LOOP_TRIPS (lavapipe: 65535, counted over the invocations it runs side
+// by side), a long walk may have been cut short, silently: a fast body's
+// walk over a grid of about 65 000 bodies or more. `note_long_walks` says
+// so in status[20].
 var<private> trips: u32;
 
 // Partners each body's scratch room holds: body_pairs shared out by grid
@@ -193,7 +171,8 @@ fn take(j: u32) {
     owned = owned + 1u;
 }
 
-// Every body of bucket h whose own cell is c (a bucket may also hold
+// Every body of a bucket (its places in the grid order, `first` to `end`)
+// whose own cell is c (a bucket may also hold
 // other cells; `any_cell`: whatever its cell) that the walk owns a pair
 // with: in the walker's own cell (`above` the walker's index; NONE for
 // another cell) those of higher index and the sleepers, in a cell behind
@@ -205,13 +184,19 @@ fn take(j: u32) {
 // roundings; the stop keeps a slack of 1e-4 m and 1e-5 of the position.)
 // The candidates' bounds come from cell_bounds, by their place in the grid
 // (grid_sort).
-fn visit_bucket(h: u32, c: vec3<i32>, any_cell: bool, above: u32, behind: bool) {
-    let end = cell_start[h + 1u];
+//
+// A walk of the whole grid (`any_cell`) visits the grid order at once
+// instead, from place `first` to `end`, without the stop (the places
+// are sorted along x only within a bucket): the same bodies in the same
+// order, in as many loop trips as the grid has bodies, where a loop over
+// the buckets took one more for each of them (65 536 in a grid of 16 384
+// bodies or more: lavapipe ended such walks part way, see `trips`).
+fn visit_places(first: u32, end: u32, c: vec3<i32>, any_cell: bool, above: u32, behind: bool) {
     let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
-    for (var k = cell_start[h]; k < end; k = k + 1u) {
+    for (var k = first; k < end; k = k + 1u) {
         trips = trips + 1u;
         let cb = cell_bound_of(k);
-        if (cb.pos.x - cb.extent.x > stop) {
+        if (!any_cell && cb.pos.x - cb.extent.x > stop) {
             break;
         }
         let j = cb.body & BODY_BITS;
@@ -225,7 +210,12 @@ fn visit_bucket(h: u32, c: vec3<i32>, any_cell: bool, above: u32, behind: bool) 
         if (walker.fast || (cb.body & FAST_BODY) != 0u) {
             takes = j != walker.index && outranks(j, box_size(cb.extent));
         }
-        if (takes && (any_cell || all(cell_of(cb.pos) == c)) && wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j) && !joined_to_walker(j)) {
+        // (whether the two are joined is the narrowphase's to say: lavapipe
+        // runs a branch whether or not a lane takes it, and a loop it
+        // enters counts against its limit even when it takes no trip, so a
+        // loop over the walker's joint ends here cost every place two of
+        // its counts, and a fast walk was cut after half the grid)
+        if (takes && (any_cell || all(cell_of(cb.pos) == c)) && wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j)) {
             take(j);
         }
     }
@@ -276,7 +266,7 @@ fn walk(i: u32) {
     let grid = in_grid(i);
     let sleeps = pair_meta[i].moves == SLEEPS;
     walker = Walker(i, state_of(i).pos, extent, pair_meta[i].bound, size, pair_meta[i].moves == MOVES,
-                    grid && is_fast(size, pair_meta[i].moves), vec2<u32>(joint_start[i], joint_start[i + 1u]));
+                    grid && is_fast(size, pair_meta[i].moves));
     owned = 0u;
     trips = 0u;
     if (wants_ground(i)) {
@@ -289,14 +279,17 @@ fn walk(i: u32) {
     }
     // one ring out: the own cell and the 13 ahead (and the 13 behind for
     // sleepers); a fast walker: the own cell and the cubes' halves ahead
-    // and behind, or every bucket when the grid has fewer
+    // and behind, or the whole grid order at once (`visit_places`) where
+    // that is the shorter walk (a cell costs two trips: its own and the end
+    // of its places' loop) or the grid has fewer buckets than it has cells
     let rings = select(1u, rings_of(size), walker.fast);
     let side = 2u * rings + 1u;
     let ahead = (side * side * side - 1u) / 2u;
     let both = walker.fast || (walker.moves && atomicLoad(&status[11]) != 0u);
     var cells = select(select(1u + ahead, 1u + 2u * ahead, both), 0u, sleeps || !grid);
-    let every = walker.fast && f32(side) * f32(side) * f32(side) >= f32(params.hash_size);
-    cells = select(cells, params.hash_size, every);
+    let cube = f32(side) * f32(side) * f32(side);
+    let every = walker.fast && (cube >= f32(params.hash_size) || 2.0 * cube >= f32(cell_start[params.hash_size]));
+    cells = select(cells, 1u, every);
     let centre = cell_of(walker.pos);
     // one loop, one call site: the kernel holds one copy of the cell's walk
     // (lavapipe's compile time grows steeply with a kernel's size)
@@ -309,13 +302,17 @@ fn walk(i: u32) {
             o = next_cell(o, select(n, n - ahead, behind), rings);
         }
         let c = centre + select(o, -o, behind);
-        visit_bucket(select(bucket_of(c), n, every), c, every, select(NONE, i, n == 0u), behind);
+        let h = bucket_of(c);
+        let first = select(cell_start[h], 0u, every);
+        let end = select(cell_start[h + 1u], cell_start[params.hash_size], every);
+        visit_places(first, end, c, every, select(NONE, i, n == 0u), behind);
+        trips = trips + 1u; // the places' loop's end
     }
+    trips = trips + 2u; // the ends of the cells' loop and the large bodies'
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         trips = trips + 1u;
         let j = large_body(k);
-        if ((grid || j > i) && wanted_bounds(state_of(j).pos, pair_meta[j].bound, pair_meta[j].extent, pair_meta[j].moves)
-            && !joined_to_walker(j)) {
+        if ((grid || j > i) && wanted_bounds(state_of(j).pos, pair_meta[j].bound, pair_meta[j].extent, pair_meta[j].moves)) {
             take(j);
         }
     }
@@ -327,23 +324,35 @@ fn walk(i: u32) {
 // where it is written, does not depend on which invocation walks it.
 @compute @workgroup_size(WORKGROUP)
 fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.body_count) {
-        return;
+    if (gid.x < params.body_count) {
+        let i = sorted[gid.x];
+        // the grid's arrivals are done with: the body list starts empty
+        // (`listed_body` in bindings.wgsl; contact_lists fills it)
+        sorted[params.body_count + gid.x] = NONE;
+        writing = false;
+        room_start = gid.x * scratch_room();
+        walk(i);
+        pair_meta[i].owned = owned;
+        note_long_walks();
     }
-    let i = sorted[gid.x];
-    // the grid's arrivals are done with: the body list starts empty
-    // (`listed_body` in bindings.wgsl; contact_lists fills it)
-    sorted[params.body_count + gid.x] = NONE;
-    writing = false;
-    room_start = gid.x * scratch_room();
-    walk(i);
-    note_long_walk();
-    pair_meta[i].owned = owned;
 }
 
-// Sets status[20] if this walk may have been cut short (see `trips`).
-fn note_long_walk() {
-    if (trips > LOOP_TRIPS / 8u) {
+// The loop trips of the workgroup's walks, summed (an integer sum: the same
+// whatever the order).
+var<workgroup> group_trips: atomic<u32>;
+
+// Sets status[20] if a walk of the workgroup may have been cut short.
+// Lavapipe runs 8 invocations side by side (a vector) and counts a loop's
+// trips once for them all, as many as the longest takes; nested loops and
+// loops one after the other add up. So the trips a vector's loops take
+// count at most the sum of its invocations' trips, and at most the sum of
+// the workgroup's, which this tests: a ball at 3000 m/s walking the 20 164
+// bodies of its grid beside 63 short walks sums to about 21 500, within the
+// limit, and is not reported (each walk tested against an eighth of the
+// limit, as before, reported it). Each walk adds its trips and tests the
+// sum so far: the last to add tests the whole sum, whatever the order.
+fn note_long_walks() {
+    if (atomicAdd(&group_trips, trips) + trips >= LOOP_TRIPS) {
         atomicStore(&status[20], 1u);
     }
 }

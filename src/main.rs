@@ -595,8 +595,8 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if report.walks_cut {
         eprintln!(
             "warning: a body's pair walk was long enough that {} may have cut it short (it ends an invocation's \
-             loops after 65535 trips): a body far faster than its neighbours in a large scene, or one with thousands \
-             of joints, may have missed contacts",
+             loops after 65535 trips): a body far faster than its neighbours, in a scene of about 65 000 bodies or \
+             more, may have missed contacts",
             gpu.info.name
         );
     }

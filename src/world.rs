@@ -170,8 +170,8 @@ pub struct ContactReport {
     pub dropped: bool,
     /// Whether any step so far had a body's pair walk long enough that the
     /// driver may have cut it short (lavapipe ends an invocation's loops
-    /// past 65535 trips: a body far faster than its neighbours in a large
-    /// scene, or one with thousands of joints); its pairs may be missing.
+    /// past 65535 trips: a body far faster than its neighbours, in a scene
+    /// of about 65 000 bodies or more); its pairs may be missing.
     pub walks_cut: bool,
 }
 

@@ -243,16 +243,14 @@ impl Stage {
             Stage::GridScanAdd => &[Params, CellStart, BlockSums],
             Stage::GridScatter => &[Params, Props, StateIn, CellCount, CellStart],
             Stage::GridSort => &[Params, Props, StateIn, CellStart, Sorted, PairMeta],
-            Stage::PairsCount => {
-                &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs, CellBounds]
+            Stage::PairsCount => &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds],
+            Stage::PairsWrite => {
+                &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds]
             }
-            Stage::PairsWrite => &[
-                Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, JointStart, JointRefs, PairMeta, BodyPairs,
-                CellBounds,
-            ],
-            Stage::Narrowphase | Stage::NarrowphaseGround => {
-                &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs, Points]
+            Stage::Narrowphase => {
+                &[Params, Props, StateIn, Pairs, Manifolds, Status, JointStart, JointRefs, PairMeta, BodyPairs, Points]
             }
+            Stage::NarrowphaseGround => &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs, Points],
             Stage::ContactLists => &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
             Stage::NarrowphaseClip => &[Params, Props, StateIn, Manifolds, Status, PairMeta, Points],
             Stage::Integrate => &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta, Snaps, BodyPairs, Snaps1],
