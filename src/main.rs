@@ -509,6 +509,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         scene.settings.dt = dt;
     }
     if let Some(track) = &track {
+        track.check_masses(&scene)?;
         warn_late_events(track, args.steps, scene.settings.dt);
     }
     let mut world = World::with_gpu(gpu.clone(), &scene)?;

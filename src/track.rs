@@ -213,6 +213,20 @@ impl Track {
         }
     }
 
+    /// Refuses a `fixed` event's mass that the body's shape makes unusable
+    /// (an inverse mass or inertia f32 cannot hold), naming the event, as the
+    /// scene's own masses are refused; [`Track::check`] first.
+    pub fn check_masses(&self, scene: &crate::Scene) -> Result<(), TrackError> {
+        for (e, &k) in self.events.iter().zip(&self.origin) {
+            if let Action::Fixed { body, mass: Some(m), .. } = e.action {
+                if let Some(why) = scene.bodies.get(body).and_then(|b| crate::scene::mass_problem(&b.shape, m)) {
+                    return Err(TrackError::invalid(format!("events[{k}].fixed.mass"), why));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The events, sorted by time.
     pub fn events(&self) -> &[Event] {
         &self.events

@@ -180,6 +180,9 @@ fn errors_name_the_field() {
         // a mass f32 cannot invert, from the density the user gave
         (body(r#", "density": 1e-44"#), "bodies[1].density: density 1e-44: mass "),
         (body(r#", "mass": 1e-39"#), "bodies[1].mass: mass 1e-39 kg with this shape gives inverse mass inf"),
+        // subnormal inverses: a GPU reads them as 0 (this box turned
+        // non-finite at its first contact)
+        (body(r#", "mass": 3e38"#), "bodies[1].mass: mass 3e38 kg with this shape gives inverse mass 3.333333e-39"),
         (body(r#", "fixed": 1"#), "bodies[1].fixed: invalid type"),
         (
             r#"{"bodies": [{"shape": {"type": "sphere", "radius": 1}, "position": [0, 3, 0]}],

@@ -175,6 +175,26 @@ pub(super) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Res
     Ok(())
 }
 
+/// Why `mass` (kg) is unusable for a movable body of `shape`, if it is (see
+/// `inverse_problem`): what an input that makes a body dynamic is checked by.
+pub fn mass_problem(shape: &Shape, mass: f32) -> Option<String> {
+    if !(mass.is_finite() && mass > 0.0) {
+        return Some(format!("must be a positive finite number of kg, got {}", show(mass)));
+    }
+    let body = Body {
+        shape: shape.clone(),
+        position: [0.0; 3],
+        orientation: [0.0, 0.0, 0.0, 1.0],
+        linear_velocity: [0.0; 3],
+        angular_velocity: [0.0; 3],
+        mass,
+        fixed: false,
+        restitution: None,
+        friction: None,
+    };
+    inverse_problem(&body)
+}
+
 /// Why a movable body's mass and size are unusable, if they are: a valid
 /// but extreme mass and size can still overflow f32 in the inverse mass or
 /// inertia, and the solver needs those finite and positive.
@@ -184,12 +204,15 @@ pub(super) fn inverse_problem(body: &Body) -> Option<String> {
     }
     let inverse_mass = body.inverse_mass();
     let inverse_inertia = body.inverse_inertia();
-    let usable = |x: f32| x.is_finite() && x > 0.0;
+    // a GPU reads a subnormal as 0 (a box of 3e38 kg, inverse mass 3.3e-39,
+    // turned non-finite at its first contact)
+    let usable = |x: f32| x.is_finite() && x >= f32::MIN_POSITIVE;
     if usable(inverse_mass) && inverse_inertia.iter().all(|&x| usable(x)) {
         return None;
     }
     Some(format!(
-        "mass {} kg with this shape gives inverse mass {} and inverse inertia {:?}, which are not positive finite numbers",
+        "mass {} kg with this shape gives inverse mass {} and inverse inertia {:?}, which are not finite numbers of at \
+         least 1.2e-38 (a GPU reads smaller ones as 0)",
         show(body.mass),
         show(inverse_mass),
         inverse_inertia

@@ -92,7 +92,8 @@ pub enum BodyInput {
     /// `false` makes a fixed body dynamic again, at rest, with `mass` (kg)
     /// and the inertia of a solid of its shape, or with `mass: None` the mass
     /// it had when it was made fixed. A body loaded as fixed has no mass on
-    /// record: it needs `Some(mass)` (with `None` it gets 1 kg).
+    /// record: it needs `Some(mass)` (with `None` it gets 1 kg). A mass whose
+    /// inverse mass or inertia f32 cannot hold is refused, as a scene's is.
     Fixed { body: usize, fixed: bool, mass: Option<f32> },
 }
 
@@ -411,9 +412,8 @@ impl World {
                 }
                 BodyInput::Fixed { fixed, mass, .. } => {
                     if let Some(m) = mass {
-                        if !(m.is_finite() && m > 0.0) {
-                            return Err(Error::Input(format!("{}: must be a positive finite number of kg, got {m}", at("mass"))));
-                        }
+                        // what the scene's own mass is checked by, for the body's shape
+                        check_sane(&at("mass"), crate::scene::mass_problem(&self.scene.bodies[body].shape, m))?;
                     }
                     op.kind = INPUT_FIXED;
                     op.a = [fixed as u32 as f32, mass.unwrap_or(0.0), 0.0, 0.0];

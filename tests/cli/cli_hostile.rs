@@ -560,6 +560,26 @@ fn steps_too_short_for_the_poses_are_refused_naming_the_field() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A track's `fixed` mass is checked as the scene's own masses are, for
+/// the body's shape, before the first step: 3e38 kg gives a unit box an
+/// inverse mass a GPU reads as 0 (it turned non-finite at step 43).
+#[test]
+fn a_track_mass_the_shape_cannot_hold_is_refused_naming_the_event() {
+    let (dir, scene, _) = workdir("track-mass");
+    let track = dir.join("track.json");
+    for mass in ["3e38", "1e-40"] {
+        let text = format!(r#"{{"events": [{{"t": 0, "fixed": {{"body": 0, "fixed": false, "mass": {mass}}}}}]}}"#);
+        std::fs::write(&track, text).unwrap();
+        let args = ["run", s(&scene), "--steps", "60", "--input", s(&track)];
+        let (out, _) = capped(&args);
+        if no_adapter(&out) {
+            return;
+        }
+        assert_refused(&args, &out, &["events[0].fixed.mass", mass, "a GPU reads smaller ones as 0"]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn malformed_scene_files_are_named_with_the_line() {
     let (dir, _, _) = workdir("malformed");

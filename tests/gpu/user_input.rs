@@ -311,6 +311,34 @@ fn switching_fixed_and_dynamic() {
     assert!(rel_err(dw, want) < 0.02, "spin change {dw:?}, want {want:?}");
 }
 
+/// A body loaded fixed has no mass kept: made dynamic without one it gets
+/// 1 kg, as `BodyInput::Fixed` says. Before, it got an infinite mass (the
+/// inverse of the 0 kept) and turned non-finite at its first contact. A
+/// mass f32 cannot invert for its shape is refused, as a scene's is.
+#[test]
+fn a_body_loaded_fixed_made_dynamic_without_a_mass_weighs_a_kilogram() {
+    let mut f = box_body([0.5; 3], [0.0, 3.0, 0.0]);
+    f.fixed = true;
+    let mut sc = scene(Settings::default(), vec![f]);
+    sc.ground = Some(verlet::scene::Ground { height: 0.0 });
+    let Some(mut w) = world(&sc) else { return };
+    for mass in [3e38f32, 1e-40] {
+        let err = input_error(w.set_dynamic(0, mass));
+        assert!(err.starts_with("mass: mass ") && err.contains("a GPU reads smaller ones as 0"), "{err}");
+    }
+    w.set_fixed(0, false).unwrap();
+    // 1 kg: an impulse of 2 N s along x gives 2 m/s (in the air)
+    w.apply_impulse(0, [2.0, 0.0, 0.0], None).unwrap();
+    w.step(1).unwrap();
+    let vx = w.read_state().unwrap()[0].linear_velocity[0];
+    assert!((vx - 2.0).abs() < 1e-3, "an impulse of 2 N s gave {vx} m/s: not 1 kg");
+    // and it lands and rests
+    w.step(240).unwrap();
+    assert_eq!(w.faults().unwrap(), None);
+    let s = w.read_state().unwrap()[0];
+    assert!((s.position[1] - 0.5).abs() < 0.01, "landed at {:?}", s.position);
+}
+
 fn input_error(r: Result<(), Error>) -> String {
     match r {
         Err(Error::Input(msg)) => msg,
