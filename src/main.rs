@@ -418,6 +418,20 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// Gives the scene the step `--dt` asks for, if any, and checks the scene
+/// with it: a step too short for its substeps, or so long that bodies sink
+/// into the ground, names `--dt` (the scene's own `settings.dt` was fine).
+fn with_dt(scene: &mut Scene, dt: Option<f32>) -> Result<(), Error> {
+    let Some(dt) = dt else { return Ok(()) };
+    scene.settings.dt = dt;
+    scene.validate().map_err(|e| match e {
+        verlet::load_error::LoadError::Invalid { field, message } if field == "settings.dt" => {
+            Error::Input(format!("--dt: {message}"))
+        }
+        e => e.into(),
+    })
+}
+
 /// The track's events that acted before the step a fault was found in or
 /// the one before (where the state may have gone bad), named for the
 /// fault's message: an impulse of 1e30 N s is the input's doing, not the
@@ -458,9 +472,6 @@ fn run(args: RunArgs) -> Result<(), Error> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::Input(format!("--dt: must be a positive number of seconds, got {dt}")));
         }
-        if dt < verlet::world::MIN_DT {
-            return Err(Error::Input(format!("--dt: {}", verlet::scene::dt_too_short(dt))));
-        }
     }
     if args.every == 0 {
         return Err(Error::Input("--every: must be at least 1".into()));
@@ -476,7 +487,8 @@ fn run(args: RunArgs) -> Result<(), Error> {
             if args.count.is_some() {
                 eprintln!("warning: --count: a scene file gives its own bodies (--count is for --builtin); ignored");
             }
-            let scene = load_scene(path)?;
+            let mut scene = load_scene(path)?;
+            with_dt(&mut scene, args.dt)?;
             let n = scene.bodies.len() as u64;
             (Some(scene), n)
         }
@@ -499,15 +511,16 @@ fn run(args: RunArgs) -> Result<(), Error> {
 
     let gpu = Arc::new(Gpu::new()?);
     let started = Instant::now();
-    let mut scene = match (file_scene, &args.builtin) {
+    let scene = match (file_scene, &args.builtin) {
         (Some(scene), _) => scene,
         // the adapter's limit, still before the scene is built
-        (None, Some(name)) => scenes::checked(name, args.count, args.seed, verlet::world::max_bodies(&gpu))?,
+        (None, Some(name)) => {
+            let mut scene = scenes::checked(name, args.count, args.seed, verlet::world::max_bodies(&gpu))?;
+            with_dt(&mut scene, args.dt)?;
+            scene
+        }
         (None, None) => return Err(Error::Input("give a scene file or --builtin NAME".into())),
     };
-    if let Some(dt) = args.dt {
-        scene.settings.dt = dt;
-    }
     if let Some(track) = &track {
         track.check_masses(&scene)?;
         warn_late_events(track, args.steps, scene.settings.dt);

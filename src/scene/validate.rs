@@ -30,9 +30,6 @@ impl Scene {
 
 pub(super) fn validate_settings(s: &Settings) -> Result<(), SceneError> {
     check_positive(s.dt, "settings.dt")?;
-    if s.dt < crate::world::MIN_DT {
-        return Err(SceneError::invalid("settings.dt", dt_too_short(s.dt)));
-    }
     check_all_finite(&s.gravity, "settings.gravity")?;
     if !(1..=MAX_ITERATIONS).contains(&s.iterations) {
         return Err(SceneError::invalid(
@@ -51,54 +48,85 @@ pub(super) fn validate_settings(s: &Settings) -> Result<(), SceneError> {
     if !(1..=MAX_SUBSTEPS).contains(&s.substeps) {
         return Err(SceneError::invalid("settings.substeps", format!("must be between 1 and {MAX_SUBSTEPS}, got {}", s.substeps)));
     }
+    if let Some(why) = dt_too_short(s.dt, s.substeps) {
+        // blame the setting the user moved off its default
+        let field = if s.dt == Settings::default().dt { "settings.substeps" } else { "settings.dt" };
+        return Err(SceneError::invalid(field, why));
+    }
     Ok(())
 }
 
-/// Refuses a step so long that bodies would rest visibly inside the ground.
-/// Gravity moves a body |g| h^2 into whatever it rests on every substep of
-/// h, and `iterations` Jacobi sweeps relaxed by c_r take back all but
-/// (1 - c_r)^iterations of it, so that much stays inside, every substep,
-/// and a body rests (and falls asleep) there: measured, unit cubes came to
-/// rest 6 mm inside the ground at dt 0.2 s, 39 mm at 0.5 s and 156 mm at
-/// 1 s (3 substeps, 3 sweeps, c_r 0.5), as the formula says. The limit is a
-/// tenth of the smallest moving body's bounding radius.
-/// Why a step of `dt` s is too short (`world::MIN_DT`).
-pub fn dt_too_short(dt: f32) -> String {
-    format!(
-        "must be at least {:e} s, got {}: over shorter steps the rounding of the poses reads as speed, and the step stops \
-         bodies at rest as thrown",
-        crate::world::MIN_DT,
-        show(dt)
-    )
+/// Why a step of `dt` s in `substeps` substeps is too short, if it is
+/// (`world::MIN_SUBSTEP`; a part in a million below it is let by, so 3e-5 s
+/// in 3 substeps passes).
+pub fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
+    let h = dt as f64 / substeps.max(1) as f64;
+    (h < crate::world::MIN_SUBSTEP as f64 * (1.0 - 1e-6)).then(|| {
+        format!(
+            "a step of {} s in {substeps} substeps makes substeps of {:.3e} s, shorter than {:e} s: over shorter substeps the \
+         rounding of the poses reads as speed (a pyramid placed at rest read 0.35 m/s at 3.3e-7 s), and nothing comes \
+         to rest; lengthen dt or take fewer substeps",
+            show(dt),
+            h,
+            crate::world::MIN_SUBSTEP
+        )
+    })
 }
 
+/// Refuses a step so long that bodies would rest visibly inside the ground,
+/// or sink through it. Gravity moves a body |g| h^2 into whatever it rests
+/// on every substep of h, and `iterations` Jacobi sweeps relaxed by c_r
+/// take back all but (1 - c_r)^iterations of it, so that much stays inside,
+/// every substep, and a body rests (and falls asleep) there: measured, unit
+/// cubes came to rest 6 mm inside the ground at dt 0.2 s, 39 mm at 0.5 s
+/// and 156 mm at 1 s (3 substeps, 3 sweeps, c_r 0.5), as the formula says.
+/// The limit is a tenth of the smallest moving body's bounding radius. What
+/// stays inside is old overlap by the next substep, which the solve pushes
+/// out at no more than `MAX_DEPENETRATION_SPEED` (3 m/s) times h: where
+/// more stays, it adds up and the body sinks through the ground. Measured
+/// at the default dt, a unit box rested 2.7 cm inside at 5000 m/s^2 and
+/// fell through at 6000 (1.2 m below in 4 s), where (1 - c_r)^iterations
+/// |g| h is 3.5 and 4.2 m/s; this refuses from 3 m/s (4320 m/s^2 there).
+/// Only gravity's part into the ground (along -y) counts: sideways or
+/// upward it presses nothing into it.
 pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError> {
     let Some(smallest) = bodies.iter().filter(|b| !b.fixed).map(|b| b.bounding_radius()).reduce(f32::min) else {
         return Ok(());
     };
+    use crate::world::MAX_DEPENETRATION_SPEED;
     let h = s.dt as f64 / s.substeps as f64;
-    let g = s.gravity.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+    let g = (-s.gravity[1] as f64).max(0.0);
     let left = (1.0 - s.relaxation as f64).powi(s.iterations as i32);
     let sink = left * g * h * h;
     let limit = 0.1 * smallest as f64;
-    if sink <= limit {
+    let speed = left * g * h;
+    if sink <= limit && speed <= MAX_DEPENETRATION_SPEED as f64 {
         return Ok(());
     }
     // blame the setting the user moved off its default
     let field = if s.dt != Settings::default().dt || g <= 9.81 { "settings.dt" } else { "settings.gravity" };
-    Err(SceneError::invalid(
-        field,
+    let pressed = format!(
+        "gravity into the ground ({g:.3e} m/s^2) moves a body {:.3e} m a substep (dt {} s / {} substeps) and {} sweeps \
+         at relaxation {} leave {sink:.3e} m of that inside",
+        g * h * h,
+        show(s.dt),
+        s.substeps,
+        s.iterations,
+        show(s.relaxation)
+    );
+    let why = if sink > limit {
         format!(
-            "a step this long lets bodies rest inside the ground: gravity ({g:.3e} m/s^2) moves a body {:.3e} m a substep \
-             (dt {} s / {} substeps) and {} sweeps at relaxation {} leave {sink:.3e} m of that inside, more than a tenth of \
-             the smallest body's bounding radius ({limit:.3e} m); lower dt or gravity, or raise settings.substeps",
-            g * h * h,
-            show(s.dt),
-            s.substeps,
-            s.iterations,
-            show(s.relaxation)
-        ),
-    ))
+            "a step this long lets bodies rest inside the ground: {pressed}, more than a tenth of the smallest body's \
+             bounding radius ({limit:.3e} m); lower dt or gravity, or raise settings.substeps"
+        )
+    } else {
+        format!(
+            "bodies would sink through the ground: {pressed} every substep, {speed:.3} m/s, more than the \
+             {MAX_DEPENETRATION_SPEED} m/s at which old overlap is pushed out; lower dt or gravity, or raise \
+             settings.substeps or settings.iterations"
+        )
+    };
+    Err(SceneError::invalid(field, why))
 }
 
 fn length(v: [f32; 3]) -> f64 {

@@ -540,23 +540,35 @@ fn negative_numbers_are_refused_saying_what_the_flag_takes() {
 #[test]
 fn steps_too_short_for_the_poses_are_refused_naming_the_field() {
     // 1e-9 s ran a step and stopped a pile at rest as thrown by the solver;
-    // 1e-45 as non-finite
-    for dt in ["1e-45", "1e-9", "9.9e-7"] {
-        assert_refused_quickly(&["run", "--builtin", "pile", "--steps", "1", "--dt", dt], &["--dt", "at least 1e-6 s", dt]);
-    }
+    // 1e-45 as non-finite; 1e-6 s (3 substeps) left a pyramid at rest
+    // moving at 0.35 m/s
     let (dir, scene, _) = workdir("short-dt");
+    for dt in ["1e-45", "1e-9", "2.9e-5"] {
+        assert_refused_quickly(&["run", s(&scene), "--steps", "1", "--dt", dt], &["--dt", "shorter than 1e-5 s", dt]);
+        let args = ["run", "--builtin", "pyramid", "--steps", "1", "--dt", dt];
+        let (out, _) = capped(&args);
+        if no_adapter(&out) {
+            return;
+        }
+        assert_refused(&args, &out, &["--dt", "shorter than 1e-5 s"]);
+    }
     let mut short = scenes::drop();
     short.settings.dt = 1e-9;
     std::fs::write(&scene, short.to_json()).unwrap();
-    assert_refused_quickly(&["run", s(&scene), "--steps", "1"], &["settings.dt", "at least 1e-6 s"]);
+    assert_refused_quickly(&["run", s(&scene), "--steps", "1"], &["settings.dt", "shorter than 1e-5 s"]);
+    short.settings.dt = scenes::drop().settings.dt;
+    short.settings.substeps = 64;
+    short.settings.dt = 5e-4;
+    std::fs::write(&scene, short.to_json()).unwrap();
+    assert_refused_quickly(&["run", s(&scene), "--steps", "1"], &["settings.dt", "64 substeps", "7.813e-6 s"]);
+    // a flag that makes a step too long names the flag, not the scene's field
+    std::fs::write(&scene, scenes::drop().to_json()).unwrap();
+    assert_refused_quickly(&["run", s(&scene), "--steps", "1", "--dt", "10"], &["--dt: ", "inside the ground"]);
     // the shortest step runs, and the summary shows it
-    let out = verlet(&["run", "--builtin", "drop", "--steps", "2", "--dt", "1e-6"]);
-    if no_adapter(&out) {
-        return;
-    }
+    let out = verlet(&["run", "--builtin", "drop", "--steps", "2", "--dt", "3e-5"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("2 steps of 1.000e-6 s (2.000e-6 s simulated)"), "{text}");
+    assert!(text.contains("2 steps of 0.00003 s (6.000e-5 s simulated)"), "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
