@@ -57,7 +57,8 @@
 // status[17..20]: their indirect dispatch (workgroups over them, 1, 1),
 // counted by contact_lists and copied out after it; status[20]: 1 once a
 // pair walk took so many loop trips that the driver may have cut it short
-// (LOOP_TRIPS, see pairs.wgsl), never cleared; 21 words
+// (LOOP_TRIPS, see pairs.wgsl), never cleared; status[21]: the same for a
+// contact list's sort (contact_lists, narrowphase.wgsl); 22 words
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 
 // The most trips an invocation's loops may take, summed (`Gpu::loop_trips`):

@@ -606,6 +606,14 @@ fn run(args: RunArgs) -> Result<(), Error> {
             report.pairs_max, report.pair_capacity, report.manifolds_max, report.manifold_capacity
         );
     }
+    if report.lists_cut {
+        eprintln!(
+            "warning: a body's contact list was long enough that {} may have cut its sort short (it ends an \
+             invocation's loops after 65535 trips): a body touching thousands of others may move differently \
+             from run to run",
+            gpu.info.name
+        );
+    }
     if report.walks_cut {
         eprintln!(
             "warning: a body's pair walk was long enough that {} may have cut it short (it ends an invocation's \

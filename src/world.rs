@@ -173,11 +173,15 @@ pub struct ContactReport {
     /// past 65535 trips: a body far faster than its neighbours, in a scene
     /// of about 65 000 bodies or more); its pairs may be missing.
     pub walks_cut: bool,
+    /// Whether any step so far had a body's contact list so long that the
+    /// driver may have cut its sort short (lavapipe: a body touching about
+    /// 4500 others): its sums may then differ from run to run.
+    pub lists_cut: bool,
 }
 
 /// Bytes of the `status` buffer the GPU reports through (21 words; see
 /// shaders/bindings.wgsl, binding 12).
-const STATUS_BYTES: u64 = 84;
+const STATUS_BYTES: u64 = 88;
 /// `status[2]` and `status[3]` before any fault (`NO_FAULT` in integrate.wgsl).
 pub const NO_FAULT: u32 = u32::MAX;
 /// The speed (m/s) and distance from the origin (m) beyond which a body's
@@ -1175,6 +1179,7 @@ impl World {
             manifold_capacity,
             dropped: v[1] > pair_capacity || v[5] > manifold_capacity,
             walks_cut: v[20] != 0,
+            lists_cut: v[21] != 0,
         }
     }
 
@@ -1271,7 +1276,7 @@ impl World {
 /// The status words as made: pair and manifold counts 0 (maxima
 /// atomicMax-ed), no fault (atomicMin-ed), the rest spare.
 const STATUS_INIT: [u32; (STATUS_BYTES / 4) as usize] =
-    [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1, 0];
+    [0, 0, NO_FAULT, NO_FAULT, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1, 0, 0];
 
 /// The damping per substep that removes `beta` per step: 1 - (1 - beta)^(1/n).
 fn per_substep(beta: f32, substeps: usize) -> f32 {

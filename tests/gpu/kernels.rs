@@ -606,6 +606,37 @@ fn long_lists_in_random_order_come_out_in_pair_order() {
     let (meta, _) = lists_after_contact_lists(&mut w);
     let long = meta[..n].iter().filter(|m| m.contacts >= 400).count();
     assert!(long >= n / 2, "lists of 400 manifolds or more: {long} of {n}");
+    assert!(!w.contact_report().unwrap().lists_cut, "lists sorted whole reported as cut");
+}
+
+/// A list too long for the driver to sort within its loop limit is
+/// reported (`ContactReport::lists_cut`, status[21]): a box resting on 5000
+/// fixed boxes placed at one spot lists 5000 manifolds, and its sums ran in
+/// an order that changed from run to run (it diverged at step 33 or 46 by
+/// the run). 2000 are sorted whole and not reported. Where the driver has
+/// no such limit, nothing is reported. (A list's sort is counted whether or
+/// not it was cut: what the test asserts is that a sort past the limit is
+/// reported, and one well within it is not.)
+#[test]
+fn a_list_too_long_to_sort_within_the_drivers_loops_is_reported() {
+    for (count, long) in [(2000, false), (5000, true)] {
+        let mut bodies: Vec<verlet::Body> = (0..count)
+            .map(|_| {
+                let mut b = box_body([0.5; 3], [0.0, 0.5, 0.0]);
+                b.fixed = true;
+                b
+            })
+            .collect();
+        bodies.push(box_body([0.5; 3], [0.0, 1.49, 0.0]));
+        let scene = Scene { settings: Settings::default(), ground: None, bodies, joints: vec![], camera: None };
+        let Some(mut w) = world(&scene) else { return };
+        w.step(2).unwrap();
+        let report = w.contact_report().unwrap();
+        let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
+        assert_eq!(meta[count].contacts as usize, count, "the box's list: {report:?}");
+        let limited = w.gpu().loop_trips().is_some();
+        assert_eq!(report.lists_cut, long && limited, "{count} manifolds, limited loops: {limited}");
+    }
 }
 
 /// Runs the stages up to contact_lists and checks every body's list is in
