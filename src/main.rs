@@ -28,6 +28,17 @@ macro_rules! outln {
     };
 }
 
+/// `eprintln!` that never panics: std's panics when stderr cannot be
+/// written, and with `2>/dev/full` every error became a panic (exit 101)
+/// and a run whose only line there was a warning died before its first
+/// step. What cannot be said on stderr is dropped; the exit status still
+/// says how the command ended. (It shadows std's for this crate's modules.)
+macro_rules! eprintln {
+    ($($t:tt)*) => {{
+        let _ = std::io::Write::write_fmt(&mut std::io::stderr(), format_args!("{}\n", format_args!($($t)*)));
+    }};
+}
+
 mod harness;
 mod plot;
 
