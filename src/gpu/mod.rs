@@ -335,10 +335,24 @@ const POWER_PREFS: &[&str] = &["low", "high", "none"];
 
 /// Refuses a `WGPU_BACKEND` or `WGPU_POWER_PREF` that wgpu would ignore.
 fn check_env() -> Result<(), GpuError> {
+    // a value that is not UTF-8 read as unset, and wgpu then used its default
+    for name in ["WGPU_BACKEND", "WGPU_POWER_PREF"] {
+        if let Some(value) = std::env::var_os(name).filter(|v| v.to_str().is_none()) {
+            return Err(GpuError::BadEnv(name, value.to_string_lossy().into_owned(), "text (it is not UTF-8)".into()));
+        }
+    }
     if let Ok(value) = std::env::var("WGPU_BACKEND") {
         let known = |b: &str| BACKEND_NAMES.contains(&b.trim().to_lowercase().as_str());
         if value.trim().is_empty() || !value.split(',').all(known) {
             let takes = format!("a comma-separated list of: {}", BACKEND_NAMES.join(", "));
+            return Err(GpuError::BadEnv("WGPU_BACKEND", value, takes));
+        }
+        // a backend this build lacks (`gl`) found no adapter, and the error
+        // said to install a Vulkan driver
+        let built = wgpu::Instance::enabled_backend_features();
+        if !wgpu::Backends::from_comma_list(&value).intersects(built) {
+            let names: Vec<String> = built.iter_names().map(|(name, _)| name.to_lowercase()).collect();
+            let takes = format!("a backend this build has: {}", names.join(", "));
             return Err(GpuError::BadEnv("WGPU_BACKEND", value, takes));
         }
     }

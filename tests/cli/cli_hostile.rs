@@ -638,11 +638,25 @@ fn a_scene_given_as_a_track_is_called_a_scene() {
 
 #[test]
 fn a_bad_wgpu_backend_names_the_variable_and_its_values() {
-    for (var, value, valid) in [("WGPU_BACKEND", "nonsense", "vulkan"), ("WGPU_POWER_PREF", "fastest", "high")] {
+    // (a backend this build lacks found no adapter, and the error said to
+    // install a Vulkan driver)
+    for (var, value, valid) in [
+        ("WGPU_BACKEND", "nonsense", "vulkan"),
+        ("WGPU_POWER_PREF", "fastest", "high"),
+        ("WGPU_BACKEND", "gl", "a backend this build has"),
+    ] {
         let (out, took) = capped_env(&["info"], &[(var, value)]);
         assert_refused(&["info"], &out, &[var, value, valid]);
         assert!(!stderr(&out).contains("mesa-vulkan-drivers"), "{}", stderr(&out));
         assert!(took < QUICK);
+    }
+    // a value that is not UTF-8 was read as unset
+    #[cfg(unix)]
+    for var in ["WGPU_BACKEND", "WGPU_POWER_PREF"] {
+        use std::os::unix::ffi::OsStrExt;
+        let out =
+            Command::new(env!("CARGO_BIN_EXE_verlet")).arg("info").env(var, std::ffi::OsStr::from_bytes(b"\xff")).output().unwrap();
+        assert_refused(&["info"], &out, &[var, "not UTF-8"]);
     }
 }
 
