@@ -76,9 +76,9 @@ enum Command {
         /// Bodies, boxes, rows, links, planks or ragdolls, by scene.
         #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
         count: Option<usize>,
-        /// Seed of the random scenes (cubes, pile).
-        #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = whole_u64)]
-        seed: u64,
+        /// Seed of the random scenes (cubes, pile); 1 if not given.
+        #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
+        seed: Option<u64>,
     },
     /// The adapter in use, its limits and what a body costs.
     Info,
@@ -149,9 +149,9 @@ struct RunArgs {
     /// --count of the built-in scene.
     #[arg(long, requires = "builtin", allow_negative_numbers = true, value_parser = whole_usize)]
     count: Option<usize>,
-    /// --seed of the built-in scene.
-    #[arg(long, default_value_t = 1, requires = "builtin", allow_negative_numbers = true, value_parser = whole_u64)]
-    seed: u64,
+    /// --seed of the built-in scene (1 if not given).
+    #[arg(long, requires = "builtin", allow_negative_numbers = true, value_parser = whole_u64)]
+    seed: Option<u64>,
     /// Steps to take.
     #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     steps: u64,
@@ -338,6 +338,16 @@ fn whole_u32(text: &str) -> Result<u32, String> {
     whole(text, u32::MAX)
 }
 
+/// The seed of the random built-in scenes when `--seed` is not given.
+const DEFAULT_SEED: u64 = 1;
+
+/// Warns when `--seed` is given to a built-in scene that is not random.
+fn warn_unused_seed(name: &str, seed: Option<u64>) {
+    if seed.is_some() && scenes::body_count(name, None).is_some() && !scenes::RANDOM.contains(&name) {
+        eprintln!("warning: --seed: the {name} scene is not random (the random ones: {}); ignored", scenes::RANDOM.join(", "));
+    }
+}
+
 /// Warns when `--count` is given to a built-in scene that takes none.
 fn warn_unused_count(name: &str, count: Option<usize>) {
     if count.is_some() && scenes::body_count(name, None).is_some() && scenes::default_count(name).is_none() {
@@ -345,10 +355,11 @@ fn warn_unused_count(name: &str, count: Option<usize>) {
     }
 }
 
-fn print_scene(name: &str, count: Option<usize>, seed: u64) -> Result<(), Error> {
+fn print_scene(name: &str, count: Option<usize>, seed: Option<u64>) -> Result<(), Error> {
     // bounded before it is built: any adapter's limit (`verlet run` checks this one's)
-    let scene = scenes::checked(name, count, seed, scenes::MAX_BODIES)?;
+    let scene = scenes::checked(name, count, seed.unwrap_or(DEFAULT_SEED), scenes::MAX_BODIES)?;
     warn_unused_count(name, count);
+    warn_unused_seed(name, seed);
     outln!("{}", scene.to_json())?;
     Ok(())
 }
@@ -498,6 +509,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
             if args.count.is_some() {
                 eprintln!("warning: --count: a scene file gives its own bodies (--count is for --builtin); ignored");
             }
+            if args.seed.is_some() {
+                eprintln!("warning: --seed: a scene file gives its own bodies (--seed is for --builtin); ignored");
+            }
             let mut scene = load_scene(path)?;
             with_dt(&mut scene, args.dt)?;
             let n = scene.bodies.len() as u64;
@@ -505,6 +519,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         }
         (None, Some(name)) => {
             warn_unused_count(name, args.count);
+            warn_unused_seed(name, args.seed);
             (None, scenes::check(name, args.count, scenes::MAX_BODIES)?)
         }
         (None, None) => return Err(Error::Input("give a scene file or --builtin NAME".into())),
@@ -526,7 +541,8 @@ fn run(args: RunArgs) -> Result<(), Error> {
         (Some(scene), _) => scene,
         // the adapter's limit, still before the scene is built
         (None, Some(name)) => {
-            let mut scene = scenes::checked(name, args.count, args.seed, verlet::world::max_bodies(&gpu))?;
+            let seed = args.seed.unwrap_or(DEFAULT_SEED);
+            let mut scene = scenes::checked(name, args.count, seed, verlet::world::max_bodies(&gpu))?;
             with_dt(&mut scene, args.dt)?;
             scene
         }
@@ -655,7 +671,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
 /// act before a step that is never taken.
 fn warn_late_events(track: &Track, steps: u64, dt: f32) {
     let late: Vec<f64> = track.events().iter().filter(|e| Track::step_of(e.t, dt) >= steps).map(|e| e.t).collect();
-    if let Some(first) = late.first() {
+    if let Some(&first) = late.first() {
+        // (t = 1e300 printed three hundred digits)
+        let first = if first >= 1e6 { format!("{first:e}") } else { format!("{first}") };
         eprintln!(
             "warning: --input: {} of {} events come at t >= {first} s, after the run's last step (it ends at {:.4} s): they do nothing",
             late.len(),

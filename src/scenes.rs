@@ -299,6 +299,9 @@ pub const NAMES: &[(&str, &str)] = &[
 /// (`world::max_bodies`); `verlet run` also checks the adapter's own limit.
 pub const MAX_BODIES: u64 = 1 << 20;
 
+/// The built-in scenes that `--seed` changes.
+pub const RANDOM: &[&str] = &["cubes", "pile"];
+
 /// The default `--count` of a scene that takes one; None for one that
 /// takes none (`drop`, `sphere`) or an unknown name.
 pub fn default_count(name: &str) -> Option<usize> {

@@ -685,11 +685,16 @@ fn track_events_after_the_last_step_are_warned_of() {
     }
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("warning: --input: 1 of 2 events"), "{}", stderr(&out));
+    // a far time in a few digits (1e300 printed three hundred)
+    std::fs::write(&track, r#"{"events": [{"t": 1e300, "impulse": {"body": 0, "impulse": [0, 1, 0]}}]}"#).unwrap();
+    let (out, _) = capped(&["run", "--builtin", "drop", "--steps", "3", "--input", s(&track)]);
+    assert!(stderr(&out).contains("events come at t >= 1e300 s"), "{}", stderr(&out));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `--count` with a scene file (it gives its own bodies) is warned of, not
-/// silently ignored.
+/// `--count` or `--seed` with a scene file (it gives its own bodies), or
+/// `--seed` with a scene that is not random, is warned of, not silently
+/// ignored.
 #[test]
 fn a_count_given_with_a_scene_file_is_warned_of() {
     let (dir, scene, _) = workdir("count");
@@ -699,6 +704,16 @@ fn a_count_given_with_a_scene_file_is_warned_of() {
     }
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("warning: --count: a scene file gives its own bodies"), "{}", stderr(&out));
+    // --seed too, and for a built-in scene that is not random
+    let (out, _) = capped(&["run", s(&scene), "--seed", "5", "--steps", "1"]);
+    assert!(stderr(&out).contains("warning: --seed: a scene file gives its own bodies"), "{}", stderr(&out));
+    for args in [&["run", "--builtin", "drop", "--seed", "9", "--steps", "1"][..], &["scene", "stack", "--seed", "3"]] {
+        let (out, _) = capped(args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(stderr(&out).contains("warning: --seed: the "), "{args:?}: {}", stderr(&out));
+    }
+    let (out, _) = capped(&["scene", "cubes", "--count", "3", "--seed", "3"]);
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
