@@ -310,6 +310,12 @@ fn clap_line(e: &clap::Error) -> String {
             return format!("error: {flag}: {why}, got {value}");
         }
     }
+    // a missing argument: clap names it on the lines after the first
+    if e.kind() == ErrorKind::MissingRequiredArgument {
+        if let Some(ContextValue::Strings(missing)) = e.get(ContextKind::InvalidArg) {
+            return format!("error: missing {}", missing.join(", "));
+        }
+    }
     // clap's first line names the bad flag and why
     let text = e.render().to_string();
     text.lines().next().unwrap_or("error: bad arguments").to_string()

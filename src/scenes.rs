@@ -368,7 +368,10 @@ pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, E
         } else {
             format!("built-in scenes have at most {max} (scenes::MAX_BODIES, more than any adapter holds)")
         };
-        return Err(Error::Capacity(format!("--count: the {name} scene with {what} has {bodies} bodies, but {limit}")));
+        // a count the sum saturated on has no honest figure (a pyramid of
+        // 4294967297 rows read as 9223372036854775807 bodies)
+        let has = if bodies >= u64::MAX / 4 { format!("more than {max} bodies") } else { format!("{bodies} bodies") };
+        return Err(Error::Capacity(format!("--count: the {name} scene with {what} has {has}, but {limit}")));
     }
     Ok(bodies)
 }
