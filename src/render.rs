@@ -986,8 +986,9 @@ pub fn write_png(img: &RgbaImage, path: &Path) -> Result<(), Error> {
 
 /// Writes `frames` (all of one size) as an animated GIF that loops forever,
 /// each frame shown `frame_ms` milliseconds (GIF counts in hundredths of a
-/// second, so the delay is rounded to 10 ms).
-pub fn write_gif(frames: &[RgbaImage], frame_ms: u32, path: &Path) -> Result<(), Error> {
+/// second: each frame's delay is rounded so that the frames together take
+/// their whole time).
+pub fn write_gif(frames: &[RgbaImage], frame_ms: f64, path: &Path) -> Result<(), Error> {
     let Some(first) = frames.first() else {
         return Err(Error::Input(format!("{}: no frames to write", path.display())));
     };
@@ -1004,9 +1005,14 @@ pub fn write_gif(frames: &[RgbaImage], frame_ms: u32, path: &Path) -> Result<(),
         // speed 10 of 1..30: the encoder's default balance of palette quality and time
         let mut encoder = image::codecs::gif::GifEncoder::new_with_speed(file.writer(), 10);
         encoder.set_repeat(image::codecs::gif::Repeat::Infinite).map_err(|e| image_error(path, e))?;
-        let delay = image::Delay::from_numer_denom_ms(frame_ms, 1);
+        // a GIF keeps delays in hundredths of a second: each frame's runs
+        // to where the one after it starts, rounded, so the whole plays for
+        // its frames' time (a delay of 33.3 ms rounded alone is 30 ms: 1 s
+        // played in 0.9 s)
+        let at = |k: usize| (k as f64 * frame_ms / 10.0).round() as u32;
+        let delay = |k: usize| image::Delay::from_numer_denom_ms(10 * (at(k + 1) - at(k)), 1);
         encoder
-            .encode_frames(frames.iter().map(|f| image::Frame::from_parts(f.clone(), 0, 0, delay)))
+            .encode_frames(frames.iter().enumerate().map(|(k, f)| image::Frame::from_parts(f.clone(), 0, 0, delay(k))))
             .map_err(|e| image_error(path, e))?;
     }
     file.commit()

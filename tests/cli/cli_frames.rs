@@ -84,6 +84,56 @@ fn gif_and_contact_sheet_without_frames() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A GIF plays in real time: frames recorded closer than the 20 ms that
+/// viewers keep are thinned, not shown slower. 1 s at 60 Hz played in 1.22
+/// s (61 frames of 20 ms), and 0.06 s at dt 1 ms in 1.22 s too.
+#[test]
+fn a_gif_plays_in_real_time() {
+    let dir = temp_dir("gif-time");
+    std::fs::create_dir_all(&dir).unwrap();
+    let gif = dir.join("run.gif");
+    for (steps, dt, simulated) in [("60", "0.016666668", 1.0), ("60", "0.001", 0.06)] {
+        let args = [
+            "run",
+            "--builtin",
+            "drop",
+            "--steps",
+            steps,
+            "--dt",
+            dt,
+            "--gif",
+            gif.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "24",
+        ];
+        let out = verlet(&args);
+        if no_adapter(&out) {
+            return;
+        }
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let decoder = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(std::fs::File::open(&gif).unwrap())).unwrap();
+        let frames = image::AnimationDecoder::into_frames(decoder).collect_frames().unwrap();
+        let delays: Vec<f64> = frames
+            .iter()
+            .map(|f| {
+                let (n, d) = f.delay().numer_denom_ms();
+                n as f64 / d as f64
+            })
+            .collect();
+        // the frames before the last span the run (the last one is shown as long)
+        let span: f64 = delays[..delays.len() - 1].iter().sum::<f64>() / 1e3;
+        assert!(delays.iter().all(|&d| d >= 20.0), "{dt}: delays {delays:?}");
+        assert!(
+            (span - simulated).abs() <= 0.02 + 0.02 * simulated,
+            "{dt}: {} frames span {span} s of a {simulated} s run",
+            frames.len()
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn bad_image_flags_are_refused_naming_the_flag() {
     let dir = temp_dir("refused");

@@ -338,14 +338,14 @@ fn contact_sheet_tiles_and_gif_writes() {
     let dir = std::env::temp_dir().join(format!("verlet-render-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let gif = dir.join("anim.gif");
-    render::write_gif(&frames, 100, &gif).unwrap();
+    render::write_gif(&frames, 100.0, &gif).unwrap();
     let bytes = std::fs::read(&gif).unwrap();
     assert!(bytes.starts_with(b"GIF89a"));
     let png = dir.join("sheet.png");
     render::write_png(&sheet, &png).unwrap();
     assert_eq!(image::open(&png).unwrap().to_rgba8(), sheet);
     let odd = vec![frames[0].clone(), RgbaImage::new(10, 10)];
-    assert!(matches!(render::write_gif(&odd, 100, &dir.join("bad.gif")), Err(Error::Input(_))));
+    assert!(matches!(render::write_gif(&odd, 100.0, &dir.join("bad.gif")), Err(Error::Input(_))));
     assert!(matches!(render::write_png(&sheet, &dir.join("no/such/dir.png")), Err(Error::Io { .. })));
     std::fs::remove_dir_all(&dir).unwrap();
 }
