@@ -67,6 +67,11 @@ impl Case {
                 known.join(", ")
             )));
         }
+        // a count the scene takes no count of (`drop:5`) named a case of
+        // one body "drop-5"
+        if count.is_some() && scenes::default_count(scene).is_none() {
+            return Err(Error::Input(format!("--cases: {spec:?}: the {scene} scene takes no count; give {scene:?}")));
+        }
         // the count is checked before anything is built (a case of a
         // billion boxes would take the machine's memory): any adapter's
         // bound here, the adapter's own in `run_case`
@@ -230,5 +235,9 @@ mod tests {
         assert_eq!((c.name.as_str(), c.count), ("cubes-2000", Some(2000)));
         assert!(Case::parse("nope").is_err());
         assert!(Case::parse("cubes:0").is_err());
+        // a scene that takes no count
+        let err = Case::parse("drop:5").unwrap_err().to_string();
+        assert!(err.contains("the drop scene takes no count"), "{err}");
+        assert_eq!(Case::parse("drop").unwrap().count, None);
     }
 }
