@@ -211,10 +211,10 @@ fn visit_places(first: u32, end: u32, c: vec3<i32>, any_cell: bool, above: u32, 
             takes = j != walker.index && outranks(j, box_size(cb.extent));
         }
         // (whether the two are joined is the narrowphase's to say: lavapipe
-        // runs a branch whether or not a lane takes it, and a loop it
-        // enters counts against its limit even when it takes no trip, so a
-        // loop over the walker's joint ends here cost every place two of
-        // its counts, and a fast walk was cut after half the grid)
+        // entered a loop over the walker's joint ends here at every place,
+        // in a branch no lane took as well, and counts a loop it enters
+        // against its limit even when it takes no trip: every place cost
+        // two counts, and a fast walk was cut after half the grid)
         if (takes && (any_cell || all(cell_of(cb.pos) == c)) && wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j)) {
             take(j);
         }
