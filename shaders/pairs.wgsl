@@ -36,12 +36,13 @@
 // body owns its pair with the ground. A fast body (`is_fast`) walks every
 // cell within its reach instead (or the whole grid, where that is
 // shorter), and owns its pairs with all it finds there but the faster
-// bodies (`outranks`); no other walk takes a pair with it. A pair is wanted when the two bodies' bounds come within the
-// margin and one of them moves: not fixed and awake, or asleep but woken
-// by the last step's narrowphase (pair_meta's MOVES). Only the owner
-// decides, alike in both walks (the test reads only what these passes do
-// not write). Bodies joined by a joint are listed too, and the narrowphase
-// drops their pair (see `visit_places`).
+// bodies (`outranks`); no other walk takes a pair with it. A pair is
+// wanted when the two bodies' bounds come within the margin and one of
+// them moves: not fixed and awake, or asleep but woken by the last step's
+// narrowphase (pair_meta's MOVES). Only the owner decides, alike in both
+// walks (the test reads only what these passes do not write). Bodies
+// joined by a joint are listed too, and the narrowphase drops their pair
+// (see `visit_places`).
 
 // CONTACT_MARGIN (shared with Rust, src/world.rs): the gap (m) kept as
 // contact whatever the speed.
@@ -71,9 +72,9 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
 // Whether the walking body and body j (not the walker) form a candidate
 // pair: one of them moves, their bounds (bounding spheres and world boxes,
 // grown by their reach) come within CONTACT_MARGIN. The spheres cut the
-// corners of the boxes: in a 10k pile of
-// tumbling cubes they cut the candidate pairs of the busiest step from
-// 81.9k to 44.6k, and by 8-17% once the pile has landed. (Every sum here is
+// corners of the boxes: in a 10k pile of tumbling cubes they cut the
+// candidate pairs of the busiest step from 81.9k to 44.6k, and by 8-17%
+// once the pile has landed. (Every sum here is
 // of one term of each body, so it is the same bits whichever body walks.)
 // It takes j's centre, bounds and moves as given (from cell_bounds, or
 // from state_in and pair_meta: the same values).
@@ -172,12 +173,12 @@ fn take(j: u32) {
 }
 
 // Every body of a bucket (its places in the grid order, `first` to `end`)
-// whose own cell is c (a bucket may also hold
-// other cells; `any_cell`: whatever its cell) that the walk owns a pair
-// with: in the walker's own cell (`above` the walker's index; NONE for
-// another cell) those of higher index and the sleepers, in a cell behind
-// the walker's (`behind`) the sleepers only, in one ahead of it every body,
-// and where the walker or the body is fast, as `outranks` says; up to the
+// whose own cell is c (a bucket may also hold other cells; `any_cell`:
+// whatever its cell) that the walk owns a pair with: in the walker's own
+// cell (`above` the walker's index; NONE for another cell) those of higher
+// index and the sleepers, in a cell behind the walker's (`behind`) the
+// sleepers only, in one ahead of it every body, and where the walker or
+// the body is fast, as `outranks` says; up to the
 // first whose box begins beyond the walker's along x by more than the
 // margin: a bucket is sorted by where its boxes begin (grid_sort), so no
 // later one can be wanted either. (`wanted_bounds` decides, with its own
