@@ -53,11 +53,12 @@ fn io_err(path: &Path, source: std::io::Error) -> Error {
 }
 
 /// An output file written beside its destination under a hidden temporary
-/// name (`.NAME.verlet-PID.tmp`) and renamed over the destination only when
-/// complete ([`AtomicFile::commit`]): a failed or killed run never leaves a
-/// half-written file where a whole one was expected, nor destroys the file
-/// that was there. Dropped uncommitted, the temporary file is removed (a
-/// killed process leaves it behind, under its hidden name).
+/// name (`.NAME.verlet-PID.tmp`, or `.NAME.verlet-PID-K.tmp` where that is
+/// taken: [`hidden_name`]), created new, and renamed over the destination
+/// only when complete ([`AtomicFile::commit`]): a failed or killed run never
+/// leaves a half-written file where a whole one was expected, nor destroys
+/// the file that was there. Dropped uncommitted, the temporary file is
+/// removed (a killed process leaves it behind, under its hidden name).
 pub struct AtomicFile {
     dest: PathBuf,
     temp: PathBuf,
@@ -70,8 +71,7 @@ impl AtomicFile {
     pub fn create(dest: &Path) -> Result<AtomicFile, Error> {
         let dest = std::fs::canonicalize(dest).unwrap_or_else(|_| dest.to_path_buf());
         let name = dest.file_name().ok_or_else(|| Error::Input(format!("{}: names a directory, not a file", dest.display())))?;
-        let temp = dest.with_file_name(format!(".{}.verlet-{}.tmp", name.to_string_lossy(), std::process::id()));
-        let file = File::create(&temp).map_err(|source| io_err(&dest, source))?;
+        let (temp, file) = create_hidden(&parent_dir(&dest), name, "tmp").map_err(|source| io_err(&dest, source))?;
         Ok(AtomicFile { dest, temp, writer: Some(BufWriter::new(file)) })
     }
 
@@ -187,14 +187,53 @@ pub fn check_output(flag: &str, path: &Path) -> Result<(), Error> {
     if !dir.is_dir() {
         return refuse(format!("no directory {}", dir.display()));
     }
-    let probe = dir.join(format!(".{}.verlet-{}.probe", name.to_string_lossy(), std::process::id()));
-    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
-        Ok(_) => {
+    match create_hidden(&dir, name, "probe") {
+        Ok((probe, _)) => {
             let _ = std::fs::remove_file(&probe);
             Ok(())
         }
         Err(e) => refuse(format!("cannot create files in {}: {e}", dir.display())),
     }
+}
+
+/// The most hidden names [`create_hidden`] tries for one file.
+pub const HIDDEN_TRIES: u32 = 100;
+
+/// The `k`-th name [`create_hidden`] tries in `dir` for a file of this
+/// process beside `name`: `.NAME.verlet-PID.EXT`, then
+/// `.NAME.verlet-PID-K.EXT` for k = 1, 2, ...
+pub fn hidden_name(dir: &Path, name: &std::ffi::OsStr, k: u32, ext: &str) -> PathBuf {
+    let pid = std::process::id();
+    let name = name.to_string_lossy();
+    match k {
+        0 => dir.join(format!(".{name}.verlet-{pid}.{ext}")),
+        k => dir.join(format!(".{name}.verlet-{pid}-{k}.{ext}")),
+    }
+}
+
+/// Creates a new file in `dir` under the first free [`hidden_name`],
+/// opened for reading and writing. Each name is created new (`O_EXCL`),
+/// which refuses any name already taken, a symbolic link included, so a
+/// link planted at the predictable name is never followed: the temporary
+/// file was opened with `O_TRUNC` through such a link, and the link's
+/// target (any file the user could write) was overwritten.
+fn create_hidden(dir: &Path, name: &std::ffi::OsStr, ext: &str) -> std::io::Result<(PathBuf, File)> {
+    for k in 0..HIDDEN_TRIES {
+        let path = hidden_name(dir, name, k, ext);
+        match std::fs::OpenOptions::new().read(true).write(true).create_new(true).open(&path) {
+            Ok(file) => return Ok((path, file)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::AlreadyExists,
+        format!(
+            "{} and the {} hidden names after it are all taken by files this run did not make",
+            hidden_name(dir, name, 0, ext).display(),
+            HIDDEN_TRIES - 1
+        ),
+    ))
 }
 
 /// The directory a path's file is in (`.` for a bare name).
@@ -416,6 +455,32 @@ mod tests {
         assert_eq!(std::fs::read(&first).unwrap(), b"mine");
         assert_eq!(std::fs::read(dir.join("t.csv.partial.2")).unwrap(), b"rows\n");
         assert_eq!(listing(&dir), ["t.csv.partial", "t.csv.partial.1", "t.csv.partial.2"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_planted_at_the_temporary_name_is_not_followed() {
+        let dir = scratch("planted");
+        let victim = dir.join("victim.txt");
+        std::fs::write(&victim, b"precious user data\n").unwrap();
+        // the first two names the run tries, each a link to the victim
+        let dest = dir.join("out.json");
+        let first = dir.join(format!(".out.json.verlet-{}.tmp", std::process::id()));
+        std::os::unix::fs::symlink("victim.txt", &first).unwrap();
+        std::os::unix::fs::symlink("victim.txt", hidden_name(&dir, "out.json".as_ref(), 1, "tmp")).unwrap();
+        write_file(&dest, "{}").unwrap();
+        assert_eq!(std::fs::read(&victim).unwrap(), b"precious user data\n", "the link's target was overwritten");
+        assert!(std::fs::symlink_metadata(&dest).unwrap().is_file(), "out.json is a file of its own");
+        assert_eq!(std::fs::read_to_string(&dest).unwrap(), "{}");
+        // every name taken: a clear error, and still nothing overwritten
+        for k in 2..HIDDEN_TRIES {
+            std::os::unix::fs::symlink("victim.txt", hidden_name(&dir, "out.json".as_ref(), k, "tmp")).unwrap();
+        }
+        let err = write_file(&dest, "[]").unwrap_err().to_string();
+        assert!(err.contains("out.json") && err.contains("all taken"), "{err}");
+        assert_eq!(std::fs::read(&victim).unwrap(), b"precious user data\n");
+        assert_eq!(std::fs::read_to_string(&dest).unwrap(), "{}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 
