@@ -712,7 +712,7 @@ const SHEET_TILES: usize = 24;
 /// PNG frames, and the frames kept for a GIF and a contact sheet.
 struct Recorder {
     /// The trace, written beside its path and renamed there when the run
-    /// succeeds ([`output::AtomicFile`]).
+    /// succeeds (into it, for a device or FIFO: [`output::AtomicFile`]).
     trace: Option<(PathBuf, output::AtomicFile)>,
     frames_dir: Option<PathBuf>,
     /// The frames kept for `--gif` and `--contact-sheet`.
@@ -815,7 +815,9 @@ impl Recorder {
     /// After a failed run: keeps the trace rows recorded so far beside the
     /// trace's path (`PATH.partial`, or `PATH.partial.1`, ... when a file is
     /// there: none is replaced), never at it, and says on stderr what was
-    /// kept and what was not written.
+    /// kept and what was not written. A trace into a device or FIFO keeps
+    /// its rows nowhere: nothing is written into it, and no file is made
+    /// beside it.
     fn abandon(self, args: &RunArgs) {
         let upto = match self.last_step {
             Some(step) => format!("steps 0 to {step}"),
@@ -824,6 +826,8 @@ impl Recorder {
         if let Some((path, file)) = self.trace {
             let partial = partial_path(&path);
             let kept = match self.last_step {
+                // a device or FIFO: no file is made beside it (/dev/null.partial)
+                Some(_) if file.is_special() => format!("its rows of {upto} were not kept: it is no regular file"),
                 Some(_) => match file.keep_beside(&partial) {
                     Ok(kept) if kept == partial => format!("its rows of {upto} are in {}", kept.display()),
                     Ok(kept) => {

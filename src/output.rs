@@ -59,20 +59,47 @@ fn io_err(path: &Path, source: std::io::Error) -> Error {
 /// leaves a half-written file where a whole one was expected, nor destroys
 /// the file that was there. Dropped uncommitted, the temporary file is
 /// removed (a killed process leaves it behind, under its hidden name).
+///
+/// A destination that exists and is no regular file (a device such as
+/// `/dev/null`, a FIFO, `/dev/fd/N` of a pipe; see [`is_special`]) is never
+/// renamed over: that replaced the device node with a regular file (as
+/// root, `--state-out /dev/null` left `/dev/null` a 477-byte file). Its
+/// bytes wait in a file of the temporary directory (`$TMPDIR`, else `/tmp`),
+/// unlinked as soon as it is made so that nothing stays there even after a
+/// kill, and are written into the destination at the commit, opened for
+/// writing as it is (never created, never truncated). So a failed run
+/// writes nothing into it either.
 pub struct AtomicFile {
     dest: PathBuf,
-    temp: PathBuf,
+    /// The hidden file beside `dest`, renamed over it at the commit; `None`
+    /// where `dest` is special and the bytes are copied into it instead.
+    temp: Option<PathBuf>,
     writer: Option<BufWriter<File>>,
 }
 
 impl AtomicFile {
     /// Creates the temporary file beside `dest` (a symbolic link's target,
-    /// if `dest` is one, so the link stays).
+    /// if `dest` is one, so the link stays), or for a special `dest`, in the
+    /// temporary directory.
     pub fn create(dest: &Path) -> Result<AtomicFile, Error> {
+        if is_special(dest) {
+            let dir = std::env::temp_dir();
+            let name = dest.file_name().unwrap_or("output".as_ref());
+            let (temp, file) = create_hidden(&dir, name, "tmp").map_err(|e| {
+                Error::Input(format!(
+                    "{}: its bytes wait in {} until the run ends, and no file can be made there: {e}",
+                    dest.display(),
+                    dir.display()
+                ))
+            })?;
+            // the open file stays; its name goes now, so none is left behind
+            let _ = std::fs::remove_file(&temp);
+            return Ok(AtomicFile { dest: dest.to_path_buf(), temp: None, writer: Some(BufWriter::new(file)) });
+        }
         let dest = std::fs::canonicalize(dest).unwrap_or_else(|_| dest.to_path_buf());
         let name = dest.file_name().ok_or_else(|| Error::Input(format!("{}: names a directory, not a file", dest.display())))?;
         let (temp, file) = create_hidden(&parent_dir(&dest), name, "tmp").map_err(|source| io_err(&dest, source))?;
-        Ok(AtomicFile { dest, temp, writer: Some(BufWriter::new(file)) })
+        Ok(AtomicFile { dest, temp: Some(temp), writer: Some(BufWriter::new(file)) })
     }
 
     /// Where the bytes go until the commit.
@@ -80,10 +107,20 @@ impl AtomicFile {
         self.writer.as_mut().expect("only commit and keep_as take the writer, and they consume self")
     }
 
-    /// Flushes the file and renames it over the destination.
+    /// Whether the destination is special ([`is_special`]): the bytes go
+    /// into it at the commit, and a failed run's are kept nowhere.
+    pub fn is_special(&self) -> bool {
+        self.temp.is_none()
+    }
+
+    /// Flushes the file and renames it over the destination (or, for a
+    /// special destination, writes its bytes into it).
     pub fn commit(mut self) -> Result<(), Error> {
+        let Some(temp) = self.temp.clone() else {
+            return self.copy_into_dest();
+        };
         let dest = self.dest.clone();
-        self.finish_as(&dest)
+        self.finish_as(&temp, &dest)
     }
 
     /// Flushes what was written and keeps it under `first`, or when a file
@@ -91,37 +128,67 @@ impl AtomicFile {
     /// that is free (a run's partial output, kept apart from the
     /// destination). Never replaces a file: the name is taken by a hard link
     /// (or, where the file system has none, a file created new), both of
-    /// which fail on an existing name. Returns the path kept.
+    /// which fail on an existing name. Returns the path kept. A special
+    /// destination's bytes have no file to keep: refused.
     pub fn keep_beside(mut self, first: &Path) -> Result<PathBuf, Error> {
         let writer = self.writer.take().expect("finished once");
+        let Some(temp) = self.temp.clone() else {
+            return Err(Error::Input(format!("{}: no regular file: no partial output is kept beside it", self.dest.display())));
+        };
         let kept = match writer.into_inner() {
             Ok(file) => {
                 drop(file);
-                keep_new(&self.temp, first)
+                keep_new(&temp, first)
             }
             // the bytes were on their way to `first`, not to the destination
             Err(e) => Err(io_err(first, e.into_error())),
         };
-        let _ = std::fs::remove_file(&self.temp);
+        let _ = std::fs::remove_file(&temp);
         kept
     }
 
     /// Flushes and renames; on any failure (a full disk shows first at the
     /// flush) the temporary file is removed, so none stays behind.
-    fn finish_as(&mut self, path: &Path) -> Result<(), Error> {
+    fn finish_as(&mut self, temp: &Path, path: &Path) -> Result<(), Error> {
         let writer = self.writer.take().expect("finished once");
         let done = match writer.into_inner() {
             Ok(file) => {
                 drop(file);
-                std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
+                std::fs::rename(temp, path).map_err(|source| io_err(path, source))
             }
             Err(e) => Err(io_err(&self.dest, e.into_error())),
         };
         if done.is_err() {
-            let _ = std::fs::remove_file(&self.temp);
+            let _ = std::fs::remove_file(temp);
         }
         done
     }
+
+    /// Writes the bytes held so far into the special destination, opened
+    /// as it is: no file is created there and none truncated (a FIFO's
+    /// open waits for its reader, as a shell's `>` does).
+    fn copy_into_dest(&mut self) -> Result<(), Error> {
+        use std::io::{Seek, SeekFrom};
+        let writer = self.writer.take().expect("finished once");
+        let dest = self.dest.clone();
+        let mut held = writer.into_inner().map_err(|e| io_err(&dest, e.into_error()))?;
+        held.seek(SeekFrom::Start(0)).map_err(|source| io_err(&dest, source))?;
+        let mut out = std::fs::OpenOptions::new().write(true).open(&dest).map_err(|source| io_err(&dest, source))?;
+        // a regular file put there during the run would keep its old tail
+        // past the bytes written, untruncated: not written
+        if out.metadata().is_ok_and(|m| m.is_file()) {
+            return Err(Error::Input(format!("{}: became a regular file during the run; not written", dest.display())));
+        }
+        std::io::copy(&mut held, &mut out).and_then(|_| out.flush()).map_err(|source| io_err(&dest, source))?;
+        Ok(())
+    }
+}
+
+/// Whether `path` exists (through links) and is neither a regular file nor
+/// a directory: a character or block device, a FIFO, a socket. Such a
+/// destination is written into, never replaced ([`AtomicFile`]).
+pub fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// The most numbered names [`AtomicFile::keep_beside`] tries.
@@ -165,8 +232,8 @@ fn keep_new(temp: &Path, first: &Path) -> Result<PathBuf, Error> {
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.writer.take().is_some() {
-            let _ = std::fs::remove_file(&self.temp);
+        if let (Some(_), Some(temp)) = (self.writer.take(), &self.temp) {
+            let _ = std::fs::remove_file(temp);
         }
     }
 }
@@ -174,11 +241,15 @@ impl Drop for AtomicFile {
 /// Checks, before any work, that `path` can be written as the output `flag`
 /// names: it is not a directory, and its directory exists and takes new
 /// files (probed by creating and removing a hidden file there). Creates
-/// nothing that stays.
+/// nothing that stays. A special destination ([`is_special`]) is checked
+/// by [`check_special`] instead.
 pub fn check_output(flag: &str, path: &Path) -> Result<(), Error> {
     let refuse = |why: String| Err(Error::Input(format!("{flag}: cannot write {}: {why}", path.display())));
     if path.is_dir() {
         return refuse("it is a directory".into());
+    }
+    if is_special(path) {
+        return check_special(path).or_else(refuse);
     }
     let Some(name) = path.file_name() else {
         return refuse("it names a directory, not a file".into());
@@ -193,6 +264,36 @@ pub fn check_output(flag: &str, path: &Path) -> Result<(), Error> {
             Ok(())
         }
         Err(e) => refuse(format!("cannot create files in {}: {e}", dir.display())),
+    }
+}
+
+/// Checks a special destination ([`is_special`]): no file is made beside
+/// it, so its directory need not take files, but the temporary directory
+/// where its bytes wait must. A socket takes no `open` and is refused. A
+/// device is opened for writing and closed, as a shell's `>` would open it
+/// (nothing is written). A FIFO is not opened: opening and closing its
+/// writing end would hand a reader already waiting an end of file, and
+/// its open at the end waits for a reader as a shell's `>` does.
+fn check_special(path: &Path) -> Result<(), String> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = std::fs::metadata(path).map_err(|e| e.to_string())?.file_type();
+        if kind.is_socket() {
+            return Err("it is a socket, which cannot be opened for writing".into());
+        }
+        if !kind.is_fifo() {
+            std::fs::OpenOptions::new().write(true).open(path).map_err(|e| format!("cannot open it for writing: {e}"))?;
+        }
+    }
+    let dir = std::env::temp_dir();
+    let name = path.file_name().unwrap_or("output".as_ref());
+    match create_hidden(&dir, name, "probe") {
+        Ok((probe, _)) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(format!("its bytes wait in {} until the run ends, and no file can be made there: {e}", dir.display())),
     }
 }
 
@@ -481,6 +582,79 @@ mod tests {
         assert!(err.contains("out.json") && err.contains("all taken"), "{err}");
         assert_eq!(std::fs::read(&victim).unwrap(), b"precious user data\n");
         assert_eq!(std::fs::read_to_string(&dest).unwrap(), "{}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Whether this process runs as root (it owns its `/proc/self`).
+    #[cfg(unix)]
+    fn is_root() -> bool {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata("/proc/self").is_ok_and(|m| m.uid() == 0)
+    }
+
+    /// What `held` (both ends of a FIFO) has to read, up to a marker
+    /// written last: the FIFO's bytes so far, without waiting for more.
+    #[cfg(unix)]
+    fn drain(held: &mut File) -> Vec<u8> {
+        use std::io::Read;
+        held.write_all(b"<end>").unwrap();
+        let mut got = Vec::new();
+        let mut buf = [0u8; 4096];
+        while !got.ends_with(b"<end>") {
+            let n = held.read(&mut buf).unwrap();
+            got.extend_from_slice(&buf[..n]);
+        }
+        got.truncate(got.len() - b"<end>".len());
+        got
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_or_device_is_written_into_never_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = scratch("special");
+        let fifo = dir.join("fifo");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        // both ends held here (Linux opens a FIFO read-write at once): the
+        // commit's open finds a reader, and what came through can be read
+        let mut held = std::fs::OpenOptions::new().read(true).write(true).open(&fifo).unwrap();
+        check_output("--trace", &fifo).unwrap();
+        let mut file = AtomicFile::create(&fifo).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        file.writer().flush().unwrap();
+        assert_eq!(drain(&mut held), b"", "bytes reached the FIFO before the commit");
+        file.commit().unwrap();
+        assert_eq!(drain(&mut held), b"rows\n");
+        // a failed run's: nothing reaches it
+        let mut file = AtomicFile::create(&fifo).unwrap();
+        file.writer().write_all(b"half\n").unwrap();
+        drop(file);
+        assert_eq!(drain(&mut held), b"");
+        write_file(&fifo, "{}").unwrap();
+        assert_eq!(drain(&mut held), b"{}");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO was replaced");
+        assert_eq!(listing(&dir), ["fifo"], "no file made beside it");
+        // a socket takes no open: refused before the run, by name
+        let socket = dir.join("socket");
+        let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+        let err = check_output("--state-out", &socket).unwrap_err().to_string();
+        assert!(err.starts_with("--state-out: cannot write") && err.contains("socket"), "{err}");
+        // device nodes of our own (never the system's /dev/null): root only
+        if is_root() {
+            let (null, full) = (dir.join("null"), dir.join("full"));
+            for (node, minor) in [(&null, "3"), (&full, "7")] {
+                let made = std::process::Command::new("mknod").arg(node).args(["c", "1", minor]).status().unwrap();
+                assert!(made.success(), "mknod {}", node.display());
+            }
+            check_output("--state-out", &null).unwrap();
+            write_file(&null, "{}").unwrap();
+            let err = write_file(&full, "{}").unwrap_err().to_string();
+            assert!(err.contains("full") && err.contains("No space left"), "{err}");
+            for node in [&null, &full] {
+                assert!(std::fs::metadata(node).unwrap().file_type().is_char_device(), "{} was replaced", node.display());
+            }
+            assert_eq!(listing(&dir), ["fifo", "full", "null", "socket"]);
+        }
         let _ = std::fs::remove_dir_all(&dir);
     }
 
