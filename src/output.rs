@@ -79,8 +79,8 @@ pub struct AtomicFile {
 
 impl AtomicFile {
     /// Creates the temporary file beside `dest` (a symbolic link's target,
-    /// if `dest` is one, so the link stays), or for a special `dest`, in the
-    /// temporary directory.
+    /// if `dest` is one, so the link stays: [`destination`]), or for a
+    /// special `dest`, in the temporary directory.
     pub fn create(dest: &Path) -> Result<AtomicFile, Error> {
         if is_special(dest) {
             let dir = std::env::temp_dir();
@@ -96,7 +96,7 @@ impl AtomicFile {
             let _ = std::fs::remove_file(&temp);
             return Ok(AtomicFile { dest: dest.to_path_buf(), temp: None, writer: Some(BufWriter::new(file)) });
         }
-        let dest = std::fs::canonicalize(dest).unwrap_or_else(|_| dest.to_path_buf());
+        let dest = destination(dest).ok_or_else(|| Error::Input(format!("{}: {LOOP}", dest.display())))?;
         let name = dest.file_name().ok_or_else(|| Error::Input(format!("{}: names a directory, not a file", dest.display())))?;
         let (temp, file) = create_hidden(&parent_dir(&dest), name, "tmp").map_err(|source| io_err(&dest, source))?;
         Ok(AtomicFile { dest, temp: Some(temp), writer: Some(BufWriter::new(file)) })
@@ -251,12 +251,17 @@ pub fn check_output(flag: &str, path: &Path) -> Result<(), Error> {
     if is_special(path) {
         return check_special(path).or_else(refuse);
     }
-    let Some(name) = path.file_name() else {
+    let Some(target) = destination(path) else {
+        return refuse(LOOP.into());
+    };
+    let Some(name) = target.file_name() else {
         return refuse("it names a directory, not a file".into());
     };
-    let dir = parent_dir(path);
+    let dir = parent_dir(&target);
     if !dir.is_dir() {
-        return refuse(format!("no directory {}", dir.display()));
+        let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+        let to = if link { format!(" (it is a symbolic link to {})", target.display()) } else { String::new() };
+        return refuse(format!("no directory {}{to}", dir.display()));
     }
     match create_hidden(&dir, name, "probe") {
         Ok((probe, _)) => {
@@ -337,6 +342,36 @@ fn create_hidden(dir: &Path, name: &std::ffi::OsStr, ext: &str) -> std::io::Resu
     ))
 }
 
+/// Where a write to `path` lands: its canonical form if something is
+/// there, else the path itself, or for a symbolic link to nothing (a
+/// dangling link), the name its links lead to, each read relative to its
+/// own directory. The write goes to that name, as a shell's `>` writes
+/// there, and the link stays: the link was replaced by a regular file and
+/// its target never made. `None` for links that lead round in a loop (or
+/// more than [`MAX_LINKS`] deep).
+pub fn destination(path: &Path) -> Option<PathBuf> {
+    if let Ok(real) = std::fs::canonicalize(path) {
+        return Some(real);
+    }
+    let mut at = path.to_path_buf();
+    for _ in 0..=MAX_LINKS {
+        // not a link, or nothing there: the write lands here
+        let Ok(next) = std::fs::read_link(&at) else { return Some(at) };
+        at = match at.parent() {
+            Some(dir) if !dir.as_os_str().is_empty() => dir.join(next),
+            _ => next,
+        };
+    }
+    None
+}
+
+/// The most symbolic links [`destination`] follows, as Linux's path walk
+/// (past 40 it fails with `ELOOP`).
+const MAX_LINKS: usize = 40;
+
+/// Why a path of links that leads round in a loop is not written.
+const LOOP: &str = "it is a symbolic link that leads round in a loop (or more than 40 links deep)";
+
 /// The directory a path's file is in (`.` for a bare name).
 fn parent_dir(path: &Path) -> PathBuf {
     match path.parent() {
@@ -346,12 +381,14 @@ fn parent_dir(path: &Path) -> PathBuf {
 }
 
 /// The file a path names, for comparing paths: its canonical form if it
-/// exists, else its directory's canonical form joined with its name.
+/// exists, else its directory's canonical form joined with its name (a
+/// dangling link's: the name a write through it makes, [`destination`]).
 fn resolve(path: &Path) -> PathBuf {
     if let Ok(p) = std::fs::canonicalize(path) {
         return p;
     }
-    match (std::fs::canonicalize(parent_dir(path)), path.file_name()) {
+    let path = destination(path).unwrap_or_else(|| path.to_path_buf());
+    match (std::fs::canonicalize(parent_dir(&path)), path.file_name()) {
         (Ok(dir), Some(name)) => dir.join(name),
         _ => path.to_path_buf(),
     }
@@ -655,6 +692,43 @@ mod tests {
             }
             assert_eq!(listing(&dir), ["fifo", "full", "null", "socket"]);
         }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_to_nothing_is_written_through_to_its_target() {
+        use std::os::unix::fs::symlink;
+        let dir = scratch("dangling");
+        let is_link = |p: &Path| std::fs::symlink_metadata(p).unwrap().file_type().is_symlink();
+        // a link to a name not there, and a chain of two: the target is made, the links stay
+        let (dangling, target) = (dir.join("dangling"), dir.join("target.json"));
+        symlink("target.json", &dangling).unwrap();
+        let (first, second, end) = (dir.join("first"), dir.join("second"), dir.join("sub").join("end.csv"));
+        std::fs::create_dir(dir.join("sub")).unwrap();
+        symlink("second", &first).unwrap();
+        symlink(&end, &second).unwrap();
+        for (link, to) in [(&dangling, &target), (&first, &end)] {
+            check_output("--state-out", link).unwrap();
+            assert!(same_file(link, to), "{} and {} are one output", link.display(), to.display());
+            write_file(link, "{}").unwrap();
+            assert!(is_link(link), "{} was replaced", link.display());
+            assert_eq!(std::fs::read_to_string(to).unwrap(), "{}");
+        }
+        assert!(is_link(&second));
+        // a link into a directory not there, and a loop: refused, and nothing changes
+        let (lost, round, about) = (dir.join("lost"), dir.join("round"), dir.join("about"));
+        symlink("no/such/dir/x.json", &lost).unwrap();
+        symlink("about", &round).unwrap();
+        symlink("round", &about).unwrap();
+        for (link, why) in [(&lost, "no directory"), (&round, "loop")] {
+            let err = check_output("--trace", link).unwrap_err().to_string();
+            assert!(err.starts_with("--trace: cannot write") && err.contains(why), "{err}");
+            assert!(write_file(link, "{}").is_err(), "{}", link.display());
+            assert!(is_link(link), "{} was replaced", link.display());
+        }
+        assert_eq!(listing(&dir), ["about", "dangling", "first", "lost", "round", "second", "sub", "target.json"]);
+        assert_eq!(listing(&dir.join("sub")), ["end.csv"]);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

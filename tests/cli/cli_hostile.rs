@@ -489,6 +489,29 @@ fn a_device_or_fifo_output_is_written_into_never_replaced() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+#[cfg(unix)]
+#[test]
+fn an_output_through_a_link_to_nothing_makes_the_links_target() {
+    let (dir, scene, _) = workdir("dangling");
+    let (link, target) = (dir.join("state.json"), dir.join("made.json"));
+    std::os::unix::fs::symlink("made.json", &link).unwrap();
+    // the link and its target are one output
+    assert_refused_quickly(
+        &["run", s(&scene), "--steps", "2", "--state-out", s(&link), "--trace", s(&target)],
+        &["--trace", "--state-out"],
+    );
+    let (out, _) = capped(&["run", s(&scene), "--steps", "2", "--state-out", s(&link)]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link was replaced");
+    let text = std::fs::read_to_string(&target).expect("the link's target is made");
+    assert_eq!(serde_json::from_str::<serde_json::Value>(&text).unwrap()["step"], 2);
+    assert_eq!(listing(&dir), ["made.json", "scene.json", "state.json"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 // ---------------------------------------------------------------------------
 // 3. Spin is checked
 // ---------------------------------------------------------------------------
