@@ -366,8 +366,9 @@ fn load_track(path: &Path) -> Result<Track, Error> {
 }
 
 /// Checks every output path before anything runs: each can be written
-/// (its directory exists and takes files, it is no directory), and none is
-/// an input or another output.
+/// (its directory exists and takes files, it is no directory; `--frames`'
+/// directory takes files, or can be made), and none is an input or another
+/// output.
 fn check_outputs(args: &RunArgs) -> Result<(), Error> {
     let files = [
         ("--state-out", &args.state_out),
@@ -409,9 +410,7 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
         output::check_output(flag, path)?;
     }
     if let Some(dir) = &args.frames {
-        if dir.exists() && !dir.is_dir() {
-            return Err(Error::Input(format!("--frames: cannot create directory {}: a file is there", dir.display())));
-        }
+        output::check_output_dir("--frames", dir)?;
         let others: Vec<(&str, &Path)> = outputs.iter().copied().filter(|(flag, _)| *flag != "--frames").collect();
         output::check_frames_dir(dir, &inputs, &others)?;
     }
@@ -839,8 +838,10 @@ impl Recorder {
             };
             eprintln!("note: --trace: {} was left as it was (the run failed); {kept}", path.display());
         }
-        if let Some(dir) = &self.frames_dir {
-            eprintln!("note: --frames: {} frames of {upto} were written to {}", self.frames_written, dir.display());
+        match &self.frames_dir {
+            Some(dir) if self.frames_written == 0 => eprintln!("note: --frames: no frame was written to {}", dir.display()),
+            Some(dir) => eprintln!("note: --frames: {} frames of {upto} were written to {}", self.frames_written, dir.display()),
+            None => {}
         }
         for (flag, path) in [("--gif", &args.gif), ("--contact-sheet", &args.contact_sheet), ("--state-out", &args.state_out)] {
             if let Some(path) = path {

@@ -272,6 +272,39 @@ pub fn check_output(flag: &str, path: &Path) -> Result<(), Error> {
     }
 }
 
+/// Checks, before any work, that `dir` can take the files the output
+/// `flag` writes into it (`--frames`): where it exists, it is a directory
+/// and takes new files (probed as [`check_output`] probes: `/proc/self`
+/// passed, and the run failed at its first frame); where it does not, the
+/// nearest directory above it that exists takes them, so that it can be
+/// made there. Creates nothing that stays.
+pub fn check_output_dir(flag: &str, dir: &Path) -> Result<(), Error> {
+    let refuse = |why: String| Err(Error::Input(format!("{flag}: cannot create directory {}: {why}", dir.display())));
+    let probe = |at: &Path| {
+        let (probe, _) = create_hidden(at, "frames".as_ref(), "probe")?;
+        std::fs::remove_file(probe)
+    };
+    if dir.exists() {
+        if !dir.is_dir() {
+            return refuse("a file is there".into());
+        }
+        return probe(dir)
+            .map_err(|e| Error::Input(format!("{flag}: cannot write into {}: cannot create files there: {e}", dir.display())));
+    }
+    if std::fs::symlink_metadata(dir).is_ok() {
+        return refuse("it is a symbolic link to nothing".into());
+    }
+    // made with every missing directory above it: the nearest one there must take them
+    let mut above = dir.ancestors().skip(1).map(|a| if a.as_os_str().is_empty() { Path::new(".") } else { a });
+    let Some(above) = above.find(|a| std::fs::symlink_metadata(a).is_ok()) else {
+        return refuse("no directory above it exists".into());
+    };
+    if !above.is_dir() {
+        return refuse(format!("{} is not a directory", above.display()));
+    }
+    probe(above).or_else(|e| refuse(format!("cannot create files in {}: {e}", above.display())))
+}
+
 /// Checks a special destination ([`is_special`]): no file is made beside
 /// it, so its directory need not take files, but the temporary directory
 /// where its bytes wait must. A socket takes no `open` and is refused. A

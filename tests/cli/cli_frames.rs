@@ -120,3 +120,32 @@ fn an_unwritable_frames_directory_is_refused_naming_the_flag() {
     assert_eq!(stderr.trim().lines().count(), 1, "not one line: {stderr:?}");
     let _ = std::fs::remove_file(&file);
 }
+
+#[test]
+fn a_frames_directory_that_takes_no_files_is_refused_before_the_first_step() {
+    // /proc/self is a directory in which no file can be made
+    let out = verlet(&["run", "--builtin", "drop", "--steps", "2", "--frames", "/proc/self", "--width", "8", "--height", "8"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(!stderr.contains("panicked") && !stderr.contains("note:"), "refused after the run began: {stderr}");
+    assert!(stderr.contains("--frames") && stderr.contains("/proc/self") && stderr.contains("cannot create files"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "not one line: {stderr:?}");
+}
+
+#[test]
+fn a_run_that_wrote_no_frame_says_so() {
+    // a directory where frame 0 goes: the directory takes files, but the
+    // frame cannot be put there, so the run fails at step 0
+    let dir = temp_dir("no-frame");
+    std::fs::create_dir_all(dir.join("frame_000000.png").join("inside")).unwrap();
+    let out =
+        verlet(&["run", "--builtin", "drop", "--steps", "2", "--frames", dir.to_str().unwrap(), "--width", "8", "--height", "8"]);
+    if no_adapter(&out) {
+        return;
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains(&format!("note: --frames: no frame was written to {}", dir.display())), "{stderr}");
+    assert!(!stderr.contains("no step"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
