@@ -406,13 +406,23 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
             )));
         }
     }
-    for (flag, path) in files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))) {
-        output::check_output(flag, path)?;
-    }
     if let Some(dir) = &args.frames {
         output::check_output_dir("--frames", dir)?;
         let others: Vec<(&str, &Path)> = outputs.iter().copied().filter(|(flag, _)| *flag != "--frames").collect();
         output::check_frames_dir(dir, &inputs, &others)?;
+    }
+    // An output directly in the directory --frames makes has no directory
+    // to probe yet: --frames' check above stands for it (`--frames nd --gif
+    // nd/anim.gif` was refused as "no directory nd"). Nothing is made
+    // here: the directory is made last of the set-up (`Recorder::open`),
+    // once the GPU, the world and the renderer are, so a run refused for
+    // any reason before its first step makes nothing.
+    let made = args.frames.as_deref().filter(|dir| std::fs::symlink_metadata(dir).is_err());
+    for (flag, path) in files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))) {
+        match made {
+            Some(dir) if output::is_in_dir(path, dir) => {}
+            _ => output::check_output(flag, path)?,
+        }
     }
     Ok(())
 }
@@ -494,7 +504,6 @@ fn run(args: RunArgs) -> Result<(), Error> {
         track.check(body_count as usize)?;
     }
     check_outputs(&args)?;
-    let mut recorder = Recorder::open(&args)?;
 
     let gpu = Arc::new(Gpu::new()?);
     let started = Instant::now();
@@ -511,9 +520,8 @@ fn run(args: RunArgs) -> Result<(), Error> {
         warn_late_events(track, args.steps, scene.settings.dt);
     }
     let mut world = World::with_gpu(gpu.clone(), &scene)?;
-    if recorder.wants_images() {
-        recorder.renderer = Some(Renderer::new(&gpu, &scene, args.width, args.height)?);
-    }
+    // last of the set-up: a run refused before here makes nothing
+    let mut recorder = Recorder::open(&args, &gpu, &scene)?;
     let setup = started.elapsed();
 
     let bar = ProgressBar::with_draw_target(Some(args.steps), ProgressDrawTarget::hidden());
@@ -717,7 +725,7 @@ struct Recorder {
     /// The frames kept for `--gif` and `--contact-sheet`.
     gif: Option<Reel>,
     sheet: Option<Reel>,
-    /// Made once the GPU is up, if any image is wanted.
+    /// Made if any image is wanted.
     renderer: Option<Renderer>,
     frames_written: u64,
     /// The last step recorded (trace rows and frames), if any.
@@ -725,10 +733,20 @@ struct Recorder {
 }
 
 impl Recorder {
-    /// Opens the trace (beside its path) and creates the frames directory;
-    /// `check_outputs` has checked every path already. Nothing the user
-    /// had is touched until the run succeeds.
-    fn open(args: &RunArgs) -> Result<Recorder, Error> {
+    /// Makes the renderer if any image is wanted (refusing a size beyond
+    /// the adapter's), then creates the frames directory, then opens the
+    /// trace (beside its path, which may be in that directory);
+    /// `check_outputs` has checked every path already. Called last of the
+    /// set-up, once the GPU and the world are made, so a run refused before
+    /// its first step makes nothing. Nothing the user had is touched until
+    /// the run succeeds.
+    fn open(args: &RunArgs, gpu: &Gpu, scene: &Scene) -> Result<Recorder, Error> {
+        let wants_images = args.frames.is_some() || args.gif.is_some() || args.contact_sheet.is_some();
+        let renderer = if wants_images { Some(Renderer::new(gpu, scene, args.width, args.height)?) } else { None };
+        if let Some(dir) = &args.frames {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display())))?;
+        }
         let trace = match &args.trace {
             Some(path) => {
                 let flagged = |e: Error| Error::Input(format!("--trace: {e}"));
@@ -738,13 +756,9 @@ impl Recorder {
             }
             None => None,
         };
-        if let Some(dir) = &args.frames {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display())))?;
-        }
         let gif = args.gif.as_ref().map(|_| Reel::new(GIF_FRAMES, GIF_BOX));
         let sheet = args.contact_sheet.as_ref().map(|_| Reel::new(SHEET_TILES, SHEET_BOX));
-        Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer: None, frames_written: 0, last_step: None })
+        Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer, frames_written: 0, last_step: None })
     }
 
     fn wants_images(&self) -> bool {

@@ -414,17 +414,37 @@ fn parent_dir(path: &Path) -> PathBuf {
 }
 
 /// The file a path names, for comparing paths: its canonical form if it
-/// exists, else its directory's canonical form joined with its name (a
+/// exists, else its directory's [`canonical_dir`] joined with its name (a
 /// dangling link's: the name a write through it makes, [`destination`]).
 fn resolve(path: &Path) -> PathBuf {
     if let Ok(p) = std::fs::canonicalize(path) {
         return p;
     }
     let path = destination(path).unwrap_or_else(|| path.to_path_buf());
-    match (std::fs::canonicalize(parent_dir(&path)), path.file_name()) {
-        (Ok(dir), Some(name)) => dir.join(name),
-        _ => path.to_path_buf(),
+    match path.file_name() {
+        Some(name) => canonical_dir(&parent_dir(&path)).join(name),
+        None => path,
     }
+}
+
+/// A directory's canonical form, or where it is not there (yet: one that
+/// `--frames` makes), its nearest existing parent's joined with the rest,
+/// so that `nd` and `./nd` compare equal before `nd` is made.
+fn canonical_dir(dir: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(dir) {
+        return p;
+    }
+    match dir.file_name() {
+        // the parent is shorter: this ends
+        Some(name) => canonical_dir(&parent_dir(dir)).join(name),
+        None => dir.to_path_buf(),
+    }
+}
+
+/// Whether `path` names a file directly in `dir`, compared as files
+/// through links; neither need exist yet.
+pub fn is_in_dir(path: &Path, dir: &Path) -> bool {
+    resolve(path).parent().is_some_and(|p| same_file(p, dir))
 }
 
 /// Whether two paths name one file (the same inode, through links too).
@@ -471,9 +491,7 @@ pub fn check_frames_dir(dir: &Path, inputs: &[(&str, &Path)], outputs: &[(&str, 
         )))
     };
     for (_, path) in inputs.iter().chain(outputs) {
-        let real = resolve(path);
-        let in_dir = real.parent().is_some_and(|p| same_file(p, dir));
-        if in_dir && real.file_name().is_some_and(is_frame_name) {
+        if is_in_dir(path, dir) && resolve(path).file_name().is_some_and(is_frame_name) {
             return refuse(path, named(path).unwrap_or_default());
         }
     }

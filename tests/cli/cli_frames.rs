@@ -149,3 +149,42 @@ fn a_run_that_wrote_no_frame_says_so() {
     assert!(!stderr.contains("no step"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn outputs_inside_the_frames_directory_it_makes_are_taken() {
+    let base = temp_dir("made");
+    std::fs::create_dir_all(&base).unwrap();
+    let d = |name: &str| base.join(name).to_str().unwrap().to_string();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", "--builtin", "drop", "--steps", "2", "--width", "8", "--height", "8"];
+        args.extend(extra);
+        verlet(&args)
+    };
+    // refused for another reason: nothing is made, not even the frames directory
+    for (extra, wanted) in [
+        (vec!["--frames", &d("a"), "--gif", &d("a/run.gif"), "--width", "100000"], "--width"),
+        (vec!["--frames", &d("b"), "--gif", &d("b/sub/run.gif")], "no directory"),
+        (vec!["--frames", &d("c"), "--gif", &d("c/frame_000001.png")], "--frames"),
+    ] {
+        let out = run(&extra);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{extra:?}: exit status 0");
+        assert!(stderr.contains(wanted) && !stderr.contains("panicked"), "{extra:?}: {stderr}");
+        assert_eq!(std::fs::read_dir(&base).unwrap().count(), 0, "{extra:?}: something was made");
+    }
+    let (dir, gif, sheet) = (d("new"), d("new/run.gif"), d("new/sheet.png"));
+    let (state, trace) = (d("new/./state.json"), d("new/trace.csv"));
+    let out = run(&["--frames", &dir, "--gif", &gif, "--contact-sheet", &sheet, "--state-out", &state, "--trace", &trace]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_000000.png", "frame_000001.png", "frame_000002.png", "run.gif", "sheet.png", "state.json", "trace.csv"]
+    );
+    let _ = std::fs::remove_dir_all(&base);
+}
