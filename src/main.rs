@@ -427,6 +427,37 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// Warns when `--frames DIR` holds frame-named files that this run will
+/// not replace: an earlier, longer run's frames stayed, unsaid, after the
+/// new run's, and a video made of DIR switched runs part way. They are
+/// left as they are (they may be wanted); the warning names how many and
+/// the first and last.
+fn warn_stale_frames(args: &RunArgs) {
+    let Some(dir) = &args.frames else { return };
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    // this run's frames: steps 0, K, 2K, ... and the last
+    let count = (args.steps / args.every).saturating_add(1 + u64::from(!args.steps.is_multiple_of(args.every)));
+    let mut stale: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name())
+        .filter(|name| output::is_frame_name(name) && output::frame_number(name).is_none_or(|k| k >= count))
+        .map(|name| name.to_string_lossy().into_owned())
+        .collect();
+    stale.sort();
+    let (Some(first), Some(last)) = (stale.first(), stale.last()) else { return };
+    let which = if stale.len() == 1 {
+        format!("1 frame file ({first})")
+    } else {
+        format!("{} frame files ({first} to {last})", stale.len())
+    };
+    eprintln!(
+        "warning: --frames: {} holds {which} that this run, writing {} to {}, will not replace: they stay, mixed with this run's",
+        dir.display(),
+        output::frame_name(0),
+        output::frame_name(count - 1)
+    );
+}
+
 /// The track's events that acted before the step a fault was found in or
 /// the one before (where the state may have gone bad), named for the
 /// fault's message: an impulse of 1e30 N s is the input's doing, not the
@@ -504,6 +535,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         track.check(body_count as usize)?;
     }
     check_outputs(&args)?;
+    warn_stale_frames(&args);
 
     let gpu = Arc::new(Gpu::new()?);
     let started = Instant::now();

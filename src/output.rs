@@ -472,6 +472,14 @@ pub fn is_frame_name(name: &std::ffi::OsStr) -> bool {
     digits.is_some_and(|d| d.len() >= 6 && d.iter().all(u8::is_ascii_digit))
 }
 
+/// The `k` of a name [`frame_name`] gives (`frame_000012.png`: 12); `None`
+/// for any other name, frame-named ones included (`frame_0000012.png`,
+/// which no run writes).
+pub fn frame_number(name: &std::ffi::OsStr) -> Option<u64> {
+    let k: u64 = name.to_str()?.strip_prefix("frame_")?.strip_suffix(".png")?.parse().ok()?;
+    (name == frame_name(k).as_str()).then_some(k)
+}
+
 /// Refuses, for `--frames DIR`, an input or another output that a frame
 /// would replace: a file in DIR under a frame's name (compared as files,
 /// through links), or a frame-named link in DIR to one.
@@ -789,6 +797,12 @@ mod tests {
         assert!(is_frame_name(frame_name(12_345_678).as_ref()));
         for name in ["frame_1.png", "frame_000001.PNG", "frame_00000a.png", "xframe_000001.png", "frame_000001.png.tmp"] {
             assert!(!is_frame_name(name.as_ref()), "{name}");
+        }
+        for k in [0, 12, 999_999, 1_000_000, u64::MAX] {
+            assert_eq!(frame_number(frame_name(k).as_ref()), Some(k));
+        }
+        for name in ["frame_0000012.png", "frame_+00012.png", "frame_99999999999999999999.png", "frame_1.png"] {
+            assert_eq!(frame_number(name.as_ref()), None, "{name}");
         }
     }
 }

@@ -188,3 +188,34 @@ fn outputs_inside_the_frames_directory_it_makes_are_taken() {
     );
     let _ = std::fs::remove_dir_all(&base);
 }
+
+#[test]
+fn frames_of_an_earlier_longer_run_are_warned_of() {
+    let dir = temp_dir("stale");
+    let d = dir.to_str().unwrap();
+    let run = |steps: &str| verlet(&["run", "--builtin", "drop", "--steps", steps, "--frames", d, "--width", "8", "--height", "8"]);
+    let out = run("5");
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"), "{}", String::from_utf8_lossy(&out.stderr));
+    // a frame-named file this run would never write counts too
+    std::fs::write(dir.join("frame_0000001.png"), b"not ours").unwrap();
+    // two frames now: frame_000002.png to frame_000005.png stay from the first run
+    let out = run("1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let warning = stderr.lines().find(|l| l.starts_with("warning: --frames")).unwrap_or_else(|| panic!("no warning: {stderr}"));
+    for wanted in [d, "5 frame files", "frame_0000001.png", "frame_000005.png"] {
+        assert!(warning.contains(wanted), "{wanted:?} not in {warning:?}");
+    }
+    // the frames are where they were: the warning changes nothing
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 7);
+    // a run as long as the first replaces all of its frames: no warning
+    std::fs::remove_file(dir.join("frame_0000001.png")).unwrap();
+    let out = run("5");
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"), "{}", String::from_utf8_lossy(&out.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
