@@ -394,8 +394,9 @@ fn load_track(path: &Path) -> Result<Track, Error> {
 }
 
 /// Checks every output path before anything runs: each can be written
-/// (its directory exists and takes files, it is no directory), and none is
-/// an input or another output.
+/// (its directory exists and takes files, it is no directory; `--frames`'
+/// directory takes files, or can be made), and none is an input or another
+/// output.
 fn check_outputs(args: &RunArgs) -> Result<(), Error> {
     let files = [
         ("--state-out", &args.state_out),
@@ -433,15 +434,23 @@ fn check_outputs(args: &RunArgs) -> Result<(), Error> {
             )));
         }
     }
-    for (flag, path) in files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))) {
-        output::check_output(flag, path)?;
-    }
     if let Some(dir) = &args.frames {
-        if dir.exists() && !dir.is_dir() {
-            return Err(Error::Input(format!("--frames: cannot create directory {}: a file is there", dir.display())));
-        }
+        output::check_output_dir("--frames", dir)?;
         let others: Vec<(&str, &Path)> = outputs.iter().copied().filter(|(flag, _)| *flag != "--frames").collect();
         output::check_frames_dir(dir, &inputs, &others)?;
+    }
+    // An output directly in the directory --frames makes has no directory
+    // to probe yet: --frames' check above stands for it (`--frames nd --gif
+    // nd/anim.gif` was refused as "no directory nd"). Nothing is made
+    // here: the directory is made last of the set-up (`Recorder::open`),
+    // once the GPU, the world and the renderer are, so a run refused for
+    // any reason before its first step makes nothing.
+    let made = args.frames.as_deref().filter(|dir| std::fs::symlink_metadata(dir).is_err());
+    for (flag, path) in files.iter().filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p))) {
+        match made {
+            Some(dir) if output::is_in_dir(path, dir) => {}
+            _ => output::check_output(flag, path)?,
+        }
     }
     Ok(())
 }
@@ -458,6 +467,37 @@ fn with_dt(scene: &mut Scene, dt: Option<f32>) -> Result<(), Error> {
         }
         e => e.into(),
     })
+}
+
+/// Warns when `--frames DIR` holds frame-named files that this run will
+/// not replace: an earlier, longer run's frames stayed, unsaid, after the
+/// new run's, and a video made of DIR switched runs part way. They are
+/// left as they are (they may be wanted); the warning names how many and
+/// the first and last.
+fn warn_stale_frames(args: &RunArgs) {
+    let Some(dir) = &args.frames else { return };
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    // this run's frames: steps 0, K, 2K, ... and the last
+    let count = (args.steps / args.every).saturating_add(1 + u64::from(!args.steps.is_multiple_of(args.every)));
+    let mut stale: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name())
+        .filter(|name| output::is_frame_name(name) && output::frame_number(name).is_none_or(|k| k >= count))
+        .map(|name| name.to_string_lossy().into_owned())
+        .collect();
+    stale.sort();
+    let (Some(first), Some(last)) = (stale.first(), stale.last()) else { return };
+    let which = if stale.len() == 1 {
+        format!("1 frame file ({first})")
+    } else {
+        format!("{} frame files ({first} to {last})", stale.len())
+    };
+    eprintln!(
+        "warning: --frames: {} holds {which} that this run, writing {} to {}, will not replace: they stay, mixed with this run's",
+        dir.display(),
+        output::frame_name(0),
+        output::frame_name(count - 1)
+    );
 }
 
 /// The track's events that acted before the step a fault was found in or
@@ -539,7 +579,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         track.check(body_count as usize)?;
     }
     check_outputs(&args)?;
-    let mut recorder = Recorder::open(&args)?;
+    warn_stale_frames(&args);
 
     let gpu = Arc::new(Gpu::new()?);
     let started = Instant::now();
@@ -558,15 +598,14 @@ fn run(args: RunArgs) -> Result<(), Error> {
         track.check_masses(&scene)?;
         warn_late_events(track, args.steps, scene.settings.dt);
     }
+    let mut world = World::with_gpu(gpu.clone(), &scene)?;
+    // last of the set-up: a run refused before here makes nothing
+    let mut recorder = Recorder::open(&args, &gpu, &scene)?;
     if let Some(gif) = recorder.gif.as_mut() {
         // browsers play a GIF's delays under 20 ms as 100 ms: frames closer
         // than that are thinned, not shown slower (1 s at 60 Hz played in
         // 1.22 s, 0.06 s at dt 1 ms in 1.22 s)
         gif.at_least_apart(GIF_MIN_DELAY_MS, args.every, scene.settings.dt);
-    }
-    let mut world = World::with_gpu(gpu.clone(), &scene)?;
-    if recorder.wants_images() {
-        recorder.renderer = Some(Renderer::new(&gpu, &scene, args.width, args.height)?);
     }
     let setup = started.elapsed();
 
@@ -777,13 +816,13 @@ const SHEET_TILES: usize = 24;
 /// PNG frames, and the frames kept for a GIF and a contact sheet.
 struct Recorder {
     /// The trace, written beside its path and renamed there when the run
-    /// succeeds ([`output::AtomicFile`]).
+    /// succeeds (into it, for a device or FIFO: [`output::AtomicFile`]).
     trace: Option<(PathBuf, output::AtomicFile)>,
     frames_dir: Option<PathBuf>,
     /// The frames kept for `--gif` and `--contact-sheet`.
     gif: Option<Reel>,
     sheet: Option<Reel>,
-    /// Made once the GPU is up, if any image is wanted.
+    /// Made if any image is wanted.
     renderer: Option<Renderer>,
     frames_written: u64,
     /// The last step recorded (trace rows and frames), if any.
@@ -791,10 +830,20 @@ struct Recorder {
 }
 
 impl Recorder {
-    /// Opens the trace (beside its path) and creates the frames directory;
-    /// `check_outputs` has checked every path already. Nothing the user
-    /// had is touched until the run succeeds.
-    fn open(args: &RunArgs) -> Result<Recorder, Error> {
+    /// Makes the renderer if any image is wanted (refusing a size beyond
+    /// the adapter's), then creates the frames directory, then opens the
+    /// trace (beside its path, which may be in that directory);
+    /// `check_outputs` has checked every path already. Called last of the
+    /// set-up, once the GPU and the world are made, so a run refused before
+    /// its first step makes nothing. Nothing the user had is touched until
+    /// the run succeeds.
+    fn open(args: &RunArgs, gpu: &Gpu, scene: &Scene) -> Result<Recorder, Error> {
+        let wants_images = args.frames.is_some() || args.gif.is_some() || args.contact_sheet.is_some();
+        let renderer = if wants_images { Some(Renderer::new(gpu, scene, args.width, args.height)?) } else { None };
+        if let Some(dir) = &args.frames {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display())))?;
+        }
         let trace = match &args.trace {
             Some(path) => {
                 let flagged = |e: Error| Error::Input(format!("--trace: {e}"));
@@ -804,13 +853,9 @@ impl Recorder {
             }
             None => None,
         };
-        if let Some(dir) = &args.frames {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display())))?;
-        }
         let gif = args.gif.as_ref().map(|_| Reel::new(GIF_FRAMES, GIF_BOX));
         let sheet = args.contact_sheet.as_ref().map(|_| Reel::new(SHEET_TILES, SHEET_BOX));
-        Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer: None, frames_written: 0, last_step: None })
+        Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer, frames_written: 0, last_step: None })
     }
 
     fn wants_images(&self) -> bool {
@@ -880,7 +925,9 @@ impl Recorder {
     /// After a failed run: keeps the trace rows recorded so far beside the
     /// trace's path (`PATH.partial`, or `PATH.partial.1`, ... when a file is
     /// there: none is replaced), never at it, and says on stderr what was
-    /// kept and what was not written.
+    /// kept and what was not written. A trace into a device or FIFO keeps
+    /// its rows nowhere: nothing is written into it, and no file is made
+    /// beside it.
     fn abandon(self, args: &RunArgs) {
         let upto = match self.last_step {
             Some(step) => format!("steps 0 to {step}"),
@@ -889,6 +936,8 @@ impl Recorder {
         if let Some((path, file)) = self.trace {
             let partial = partial_path(&path);
             let kept = match self.last_step {
+                // a device or FIFO: no file is made beside it (/dev/null.partial)
+                Some(_) if file.is_special() => format!("its rows of {upto} were not kept: it is no regular file"),
                 Some(_) => match file.keep_beside(&partial) {
                     Ok(kept) if kept == partial => format!("its rows of {upto} are in {}", kept.display()),
                     Ok(kept) => {
@@ -900,8 +949,10 @@ impl Recorder {
             };
             eprintln!("note: --trace: {} was left as it was (the run failed); {kept}", path.display());
         }
-        if let Some(dir) = &self.frames_dir {
-            eprintln!("note: --frames: {} frames of {upto} were written to {}", self.frames_written, dir.display());
+        match &self.frames_dir {
+            Some(dir) if self.frames_written == 0 => eprintln!("note: --frames: no frame was written to {}", dir.display()),
+            Some(dir) => eprintln!("note: --frames: {} frames of {upto} were written to {}", self.frames_written, dir.display()),
+            None => {}
         }
         for (flag, path) in [("--gif", &args.gif), ("--contact-sheet", &args.contact_sheet), ("--state-out", &args.state_out)] {
             if let Some(path) = path {

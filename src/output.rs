@@ -53,26 +53,53 @@ fn io_err(path: &Path, source: std::io::Error) -> Error {
 }
 
 /// An output file written beside its destination under a hidden temporary
-/// name (`.NAME.verlet-PID.tmp`) and renamed over the destination only when
-/// complete ([`AtomicFile::commit`]): a failed or killed run never leaves a
-/// half-written file where a whole one was expected, nor destroys the file
-/// that was there. Dropped uncommitted, the temporary file is removed (a
-/// killed process leaves it behind, under its hidden name).
+/// name (`.NAME.verlet-PID.tmp`, or `.NAME.verlet-PID-K.tmp` where that is
+/// taken: [`hidden_name`]), created new, and renamed over the destination
+/// only when complete ([`AtomicFile::commit`]): a failed or killed run never
+/// leaves a half-written file where a whole one was expected, nor destroys
+/// the file that was there. Dropped uncommitted, the temporary file is
+/// removed (a killed process leaves it behind, under its hidden name).
+///
+/// A destination that exists and is no regular file (a device such as
+/// `/dev/null`, a FIFO, `/dev/fd/N` of a pipe; see [`is_special`]) is never
+/// renamed over: that replaced the device node with a regular file (as
+/// root, `--state-out /dev/null` left `/dev/null` a 477-byte file). Its
+/// bytes wait in a file of the temporary directory (`$TMPDIR`, else `/tmp`),
+/// unlinked as soon as it is made so that nothing stays there even after a
+/// kill, and are written into the destination at the commit, opened for
+/// writing as it is (never created, never truncated). So a failed run
+/// writes nothing into it either.
 pub struct AtomicFile {
     dest: PathBuf,
-    temp: PathBuf,
+    /// The hidden file beside `dest`, renamed over it at the commit; `None`
+    /// where `dest` is special and the bytes are copied into it instead.
+    temp: Option<PathBuf>,
     writer: Option<BufWriter<File>>,
 }
 
 impl AtomicFile {
     /// Creates the temporary file beside `dest` (a symbolic link's target,
-    /// if `dest` is one, so the link stays).
+    /// if `dest` is one, so the link stays: [`destination`]), or for a
+    /// special `dest`, in the temporary directory.
     pub fn create(dest: &Path) -> Result<AtomicFile, Error> {
-        let dest = std::fs::canonicalize(dest).unwrap_or_else(|_| dest.to_path_buf());
+        if is_special(dest) {
+            let dir = std::env::temp_dir();
+            let name = dest.file_name().unwrap_or("output".as_ref());
+            let (temp, file) = create_hidden(&dir, name, "tmp").map_err(|e| {
+                Error::Input(format!(
+                    "{}: its bytes wait in {} until the run ends, and no file can be made there: {e}",
+                    dest.display(),
+                    dir.display()
+                ))
+            })?;
+            // the open file stays; its name goes now, so none is left behind
+            let _ = std::fs::remove_file(&temp);
+            return Ok(AtomicFile { dest: dest.to_path_buf(), temp: None, writer: Some(BufWriter::new(file)) });
+        }
+        let dest = destination(dest).ok_or_else(|| Error::Input(format!("{}: {LOOP}", dest.display())))?;
         let name = dest.file_name().ok_or_else(|| Error::Input(format!("{}: names a directory, not a file", dest.display())))?;
-        let temp = dest.with_file_name(format!(".{}.verlet-{}.tmp", name.to_string_lossy(), std::process::id()));
-        let file = File::create(&temp).map_err(|source| io_err(&dest, source))?;
-        Ok(AtomicFile { dest, temp, writer: Some(BufWriter::new(file)) })
+        let (temp, file) = create_hidden(&parent_dir(&dest), name, "tmp").map_err(|source| io_err(&dest, source))?;
+        Ok(AtomicFile { dest, temp: Some(temp), writer: Some(BufWriter::new(file)) })
     }
 
     /// Where the bytes go until the commit.
@@ -80,10 +107,20 @@ impl AtomicFile {
         self.writer.as_mut().expect("only commit and keep_as take the writer, and they consume self")
     }
 
-    /// Flushes the file and renames it over the destination.
+    /// Whether the destination is special ([`is_special`]): the bytes go
+    /// into it at the commit, and a failed run's are kept nowhere.
+    pub fn is_special(&self) -> bool {
+        self.temp.is_none()
+    }
+
+    /// Flushes the file and renames it over the destination (or, for a
+    /// special destination, writes its bytes into it).
     pub fn commit(mut self) -> Result<(), Error> {
+        let Some(temp) = self.temp.clone() else {
+            return self.copy_into_dest();
+        };
         let dest = self.dest.clone();
-        self.finish_as(&dest)
+        self.finish_as(&temp, &dest)
     }
 
     /// Flushes what was written and keeps it under `first`, or when a file
@@ -91,37 +128,67 @@ impl AtomicFile {
     /// that is free (a run's partial output, kept apart from the
     /// destination). Never replaces a file: the name is taken by a hard link
     /// (or, where the file system has none, a file created new), both of
-    /// which fail on an existing name. Returns the path kept.
+    /// which fail on an existing name. Returns the path kept. A special
+    /// destination's bytes have no file to keep: refused.
     pub fn keep_beside(mut self, first: &Path) -> Result<PathBuf, Error> {
         let writer = self.writer.take().expect("finished once");
+        let Some(temp) = self.temp.clone() else {
+            return Err(Error::Input(format!("{}: no regular file: no partial output is kept beside it", self.dest.display())));
+        };
         let kept = match writer.into_inner() {
             Ok(file) => {
                 drop(file);
-                keep_new(&self.temp, first)
+                keep_new(&temp, first)
             }
             // the bytes were on their way to `first`, not to the destination
             Err(e) => Err(io_err(first, e.into_error())),
         };
-        let _ = std::fs::remove_file(&self.temp);
+        let _ = std::fs::remove_file(&temp);
         kept
     }
 
     /// Flushes and renames; on any failure (a full disk shows first at the
     /// flush) the temporary file is removed, so none stays behind.
-    fn finish_as(&mut self, path: &Path) -> Result<(), Error> {
+    fn finish_as(&mut self, temp: &Path, path: &Path) -> Result<(), Error> {
         let writer = self.writer.take().expect("finished once");
         let done = match writer.into_inner() {
             Ok(file) => {
                 drop(file);
-                std::fs::rename(&self.temp, path).map_err(|source| io_err(path, source))
+                std::fs::rename(temp, path).map_err(|source| io_err(path, source))
             }
             Err(e) => Err(io_err(&self.dest, e.into_error())),
         };
         if done.is_err() {
-            let _ = std::fs::remove_file(&self.temp);
+            let _ = std::fs::remove_file(temp);
         }
         done
     }
+
+    /// Writes the bytes held so far into the special destination, opened
+    /// as it is: no file is created there and none truncated (a FIFO's
+    /// open waits for its reader, as a shell's `>` does).
+    fn copy_into_dest(&mut self) -> Result<(), Error> {
+        use std::io::{Seek, SeekFrom};
+        let writer = self.writer.take().expect("finished once");
+        let dest = self.dest.clone();
+        let mut held = writer.into_inner().map_err(|e| io_err(&dest, e.into_error()))?;
+        held.seek(SeekFrom::Start(0)).map_err(|source| io_err(&dest, source))?;
+        let mut out = std::fs::OpenOptions::new().write(true).open(&dest).map_err(|source| io_err(&dest, source))?;
+        // a regular file put there during the run would keep its old tail
+        // past the bytes written, untruncated: not written
+        if out.metadata().is_ok_and(|m| m.is_file()) {
+            return Err(Error::Input(format!("{}: became a regular file during the run; not written", dest.display())));
+        }
+        std::io::copy(&mut held, &mut out).and_then(|_| out.flush()).map_err(|source| io_err(&dest, source))?;
+        Ok(())
+    }
+}
+
+/// Whether `path` exists (through links) and is neither a regular file nor
+/// a directory: a character or block device, a FIFO, a socket. Such a
+/// destination is written into, never replaced ([`AtomicFile`]).
+pub fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// The most numbered names [`AtomicFile::keep_beside`] tries.
@@ -165,8 +232,8 @@ fn keep_new(temp: &Path, first: &Path) -> Result<PathBuf, Error> {
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.writer.take().is_some() {
-            let _ = std::fs::remove_file(&self.temp);
+        if let (Some(_), Some(temp)) = (self.writer.take(), &self.temp) {
+            let _ = std::fs::remove_file(temp);
         }
     }
 }
@@ -174,28 +241,169 @@ impl Drop for AtomicFile {
 /// Checks, before any work, that `path` can be written as the output `flag`
 /// names: it is not a directory, and its directory exists and takes new
 /// files (probed by creating and removing a hidden file there). Creates
-/// nothing that stays.
+/// nothing that stays. A special destination ([`is_special`]) is checked
+/// by [`check_special`] instead.
 pub fn check_output(flag: &str, path: &Path) -> Result<(), Error> {
     let refuse = |why: String| Err(Error::Input(format!("{flag}: cannot write {}: {why}", path.display())));
     if path.is_dir() {
         return refuse("it is a directory".into());
     }
-    let Some(name) = path.file_name() else {
+    if is_special(path) {
+        return check_special(path).or_else(refuse);
+    }
+    let Some(target) = destination(path) else {
+        return refuse(LOOP.into());
+    };
+    let Some(name) = target.file_name() else {
         return refuse("it names a directory, not a file".into());
     };
-    let dir = parent_dir(path);
+    let dir = parent_dir(&target);
     if !dir.is_dir() {
-        return refuse(format!("no directory {}", dir.display()));
+        let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+        let to = if link { format!(" (it is a symbolic link to {})", target.display()) } else { String::new() };
+        return refuse(format!("no directory {}{to}", dir.display()));
     }
-    let probe = dir.join(format!(".{}.verlet-{}.probe", name.to_string_lossy(), std::process::id()));
-    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
-        Ok(_) => {
+    match create_hidden(&dir, name, "probe") {
+        Ok((probe, _)) => {
             let _ = std::fs::remove_file(&probe);
             Ok(())
         }
         Err(e) => refuse(format!("cannot create files in {}: {e}", dir.display())),
     }
 }
+
+/// Checks, before any work, that `dir` can take the files the output
+/// `flag` writes into it (`--frames`): where it exists, it is a directory
+/// and takes new files (probed as [`check_output`] probes: `/proc/self`
+/// passed, and the run failed at its first frame); where it does not, the
+/// nearest directory above it that exists takes them, so that it can be
+/// made there. Creates nothing that stays.
+pub fn check_output_dir(flag: &str, dir: &Path) -> Result<(), Error> {
+    let refuse = |why: String| Err(Error::Input(format!("{flag}: cannot create directory {}: {why}", dir.display())));
+    let probe = |at: &Path| {
+        let (probe, _) = create_hidden(at, "frames".as_ref(), "probe")?;
+        std::fs::remove_file(probe)
+    };
+    if dir.exists() {
+        if !dir.is_dir() {
+            return refuse("a file is there".into());
+        }
+        return probe(dir)
+            .map_err(|e| Error::Input(format!("{flag}: cannot write into {}: cannot create files there: {e}", dir.display())));
+    }
+    if std::fs::symlink_metadata(dir).is_ok() {
+        return refuse("it is a symbolic link to nothing".into());
+    }
+    // made with every missing directory above it: the nearest one there must take them
+    let mut above = dir.ancestors().skip(1).map(|a| if a.as_os_str().is_empty() { Path::new(".") } else { a });
+    let Some(above) = above.find(|a| std::fs::symlink_metadata(a).is_ok()) else {
+        return refuse("no directory above it exists".into());
+    };
+    if !above.is_dir() {
+        return refuse(format!("{} is not a directory", above.display()));
+    }
+    probe(above).or_else(|e| refuse(format!("cannot create files in {}: {e}", above.display())))
+}
+
+/// Checks a special destination ([`is_special`]): no file is made beside
+/// it, so its directory need not take files, but the temporary directory
+/// where its bytes wait must. A socket takes no `open` and is refused. A
+/// device is opened for writing and closed, as a shell's `>` would open it
+/// (nothing is written). A FIFO is not opened: opening and closing its
+/// writing end would hand a reader already waiting an end of file, and
+/// its open at the end waits for a reader as a shell's `>` does.
+fn check_special(path: &Path) -> Result<(), String> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = std::fs::metadata(path).map_err(|e| e.to_string())?.file_type();
+        if kind.is_socket() {
+            return Err("it is a socket, which cannot be opened for writing".into());
+        }
+        if !kind.is_fifo() {
+            std::fs::OpenOptions::new().write(true).open(path).map_err(|e| format!("cannot open it for writing: {e}"))?;
+        }
+    }
+    let dir = std::env::temp_dir();
+    let name = path.file_name().unwrap_or("output".as_ref());
+    match create_hidden(&dir, name, "probe") {
+        Ok((probe, _)) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(format!("its bytes wait in {} until the run ends, and no file can be made there: {e}", dir.display())),
+    }
+}
+
+/// The most hidden names [`create_hidden`] tries for one file.
+pub const HIDDEN_TRIES: u32 = 100;
+
+/// The `k`-th name [`create_hidden`] tries in `dir` for a file of this
+/// process beside `name`: `.NAME.verlet-PID.EXT`, then
+/// `.NAME.verlet-PID-K.EXT` for k = 1, 2, ...
+pub fn hidden_name(dir: &Path, name: &std::ffi::OsStr, k: u32, ext: &str) -> PathBuf {
+    let pid = std::process::id();
+    let name = name.to_string_lossy();
+    match k {
+        0 => dir.join(format!(".{name}.verlet-{pid}.{ext}")),
+        k => dir.join(format!(".{name}.verlet-{pid}-{k}.{ext}")),
+    }
+}
+
+/// Creates a new file in `dir` under the first free [`hidden_name`],
+/// opened for reading and writing. Each name is created new (`O_EXCL`),
+/// which refuses any name already taken, a symbolic link included, so a
+/// link planted at the predictable name is never followed: the temporary
+/// file was opened with `O_TRUNC` through such a link, and the link's
+/// target (any file the user could write) was overwritten.
+fn create_hidden(dir: &Path, name: &std::ffi::OsStr, ext: &str) -> std::io::Result<(PathBuf, File)> {
+    for k in 0..HIDDEN_TRIES {
+        let path = hidden_name(dir, name, k, ext);
+        match std::fs::OpenOptions::new().read(true).write(true).create_new(true).open(&path) {
+            Ok(file) => return Ok((path, file)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::AlreadyExists,
+        format!(
+            "{} and the {} hidden names after it are all taken by files this run did not make",
+            hidden_name(dir, name, 0, ext).display(),
+            HIDDEN_TRIES - 1
+        ),
+    ))
+}
+
+/// Where a write to `path` lands: its canonical form if something is
+/// there, else the path itself, or for a symbolic link to nothing (a
+/// dangling link), the name its links lead to, each read relative to its
+/// own directory. The write goes to that name, as a shell's `>` writes
+/// there, and the link stays: the link was replaced by a regular file and
+/// its target never made. `None` for links that lead round in a loop (or
+/// more than [`MAX_LINKS`] deep).
+pub fn destination(path: &Path) -> Option<PathBuf> {
+    if let Ok(real) = std::fs::canonicalize(path) {
+        return Some(real);
+    }
+    let mut at = path.to_path_buf();
+    for _ in 0..=MAX_LINKS {
+        // not a link, or nothing there: the write lands here
+        let Ok(next) = std::fs::read_link(&at) else { return Some(at) };
+        at = match at.parent() {
+            Some(dir) if !dir.as_os_str().is_empty() => dir.join(next),
+            _ => next,
+        };
+    }
+    None
+}
+
+/// The most symbolic links [`destination`] follows, as Linux's path walk
+/// (past 40 it fails with `ELOOP`).
+const MAX_LINKS: usize = 40;
+
+/// Why a path of links that leads round in a loop is not written.
+const LOOP: &str = "it is a symbolic link that leads round in a loop (or more than 40 links deep)";
 
 /// The directory a path's file is in (`.` for a bare name).
 fn parent_dir(path: &Path) -> PathBuf {
@@ -206,15 +414,37 @@ fn parent_dir(path: &Path) -> PathBuf {
 }
 
 /// The file a path names, for comparing paths: its canonical form if it
-/// exists, else its directory's canonical form joined with its name.
+/// exists, else its directory's [`canonical_dir`] joined with its name (a
+/// dangling link's: the name a write through it makes, [`destination`]).
 fn resolve(path: &Path) -> PathBuf {
     if let Ok(p) = std::fs::canonicalize(path) {
         return p;
     }
-    match (std::fs::canonicalize(parent_dir(path)), path.file_name()) {
-        (Ok(dir), Some(name)) => dir.join(name),
-        _ => path.to_path_buf(),
+    let path = destination(path).unwrap_or_else(|| path.to_path_buf());
+    match path.file_name() {
+        Some(name) => canonical_dir(&parent_dir(&path)).join(name),
+        None => path,
     }
+}
+
+/// A directory's canonical form, or where it is not there (yet: one that
+/// `--frames` makes), its nearest existing parent's joined with the rest,
+/// so that `nd` and `./nd` compare equal before `nd` is made.
+fn canonical_dir(dir: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(dir) {
+        return p;
+    }
+    match dir.file_name() {
+        // the parent is shorter: this ends
+        Some(name) => canonical_dir(&parent_dir(dir)).join(name),
+        None => dir.to_path_buf(),
+    }
+}
+
+/// Whether `path` names a file directly in `dir`, compared as files
+/// through links; neither need exist yet.
+pub fn is_in_dir(path: &Path, dir: &Path) -> bool {
+    resolve(path).parent().is_some_and(|p| same_file(p, dir))
 }
 
 /// Whether two paths name one file (the same inode, through links too).
@@ -242,6 +472,14 @@ pub fn is_frame_name(name: &std::ffi::OsStr) -> bool {
     digits.is_some_and(|d| d.len() >= 6 && d.iter().all(u8::is_ascii_digit))
 }
 
+/// The `k` of a name [`frame_name`] gives (`frame_000012.png`: 12); `None`
+/// for any other name, frame-named ones included (`frame_0000012.png`,
+/// which no run writes).
+pub fn frame_number(name: &std::ffi::OsStr) -> Option<u64> {
+    let k: u64 = name.to_str()?.strip_prefix("frame_")?.strip_suffix(".png")?.parse().ok()?;
+    (name == frame_name(k).as_str()).then_some(k)
+}
+
 /// Refuses, for `--frames DIR`, an input or another output that a frame
 /// would replace: a file in DIR under a frame's name (compared as files,
 /// through links), or a frame-named link in DIR to one.
@@ -261,9 +499,7 @@ pub fn check_frames_dir(dir: &Path, inputs: &[(&str, &Path)], outputs: &[(&str, 
         )))
     };
     for (_, path) in inputs.iter().chain(outputs) {
-        let real = resolve(path);
-        let in_dir = real.parent().is_some_and(|p| same_file(p, dir));
-        if in_dir && real.file_name().is_some_and(is_frame_name) {
+        if is_in_dir(path, dir) && resolve(path).file_name().is_some_and(is_frame_name) {
             return refuse(path, named(path).unwrap_or_default());
         }
     }
@@ -419,12 +655,154 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn a_link_planted_at_the_temporary_name_is_not_followed() {
+        let dir = scratch("planted");
+        let victim = dir.join("victim.txt");
+        std::fs::write(&victim, b"precious user data\n").unwrap();
+        // the first two names the run tries, each a link to the victim
+        let dest = dir.join("out.json");
+        let first = dir.join(format!(".out.json.verlet-{}.tmp", std::process::id()));
+        std::os::unix::fs::symlink("victim.txt", &first).unwrap();
+        std::os::unix::fs::symlink("victim.txt", hidden_name(&dir, "out.json".as_ref(), 1, "tmp")).unwrap();
+        write_file(&dest, "{}").unwrap();
+        assert_eq!(std::fs::read(&victim).unwrap(), b"precious user data\n", "the link's target was overwritten");
+        assert!(std::fs::symlink_metadata(&dest).unwrap().is_file(), "out.json is a file of its own");
+        assert_eq!(std::fs::read_to_string(&dest).unwrap(), "{}");
+        // every name taken: a clear error, and still nothing overwritten
+        for k in 2..HIDDEN_TRIES {
+            std::os::unix::fs::symlink("victim.txt", hidden_name(&dir, "out.json".as_ref(), k, "tmp")).unwrap();
+        }
+        let err = write_file(&dest, "[]").unwrap_err().to_string();
+        assert!(err.contains("out.json") && err.contains("all taken"), "{err}");
+        assert_eq!(std::fs::read(&victim).unwrap(), b"precious user data\n");
+        assert_eq!(std::fs::read_to_string(&dest).unwrap(), "{}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Whether this process runs as root (it owns its `/proc/self`).
+    #[cfg(unix)]
+    fn is_root() -> bool {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata("/proc/self").is_ok_and(|m| m.uid() == 0)
+    }
+
+    /// What `held` (both ends of a FIFO) has to read, up to a marker
+    /// written last: the FIFO's bytes so far, without waiting for more.
+    #[cfg(unix)]
+    fn drain(held: &mut File) -> Vec<u8> {
+        use std::io::Read;
+        held.write_all(b"<end>").unwrap();
+        let mut got = Vec::new();
+        let mut buf = [0u8; 4096];
+        while !got.ends_with(b"<end>") {
+            let n = held.read(&mut buf).unwrap();
+            got.extend_from_slice(&buf[..n]);
+        }
+        got.truncate(got.len() - b"<end>".len());
+        got
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_or_device_is_written_into_never_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = scratch("special");
+        let fifo = dir.join("fifo");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        // both ends held here (Linux opens a FIFO read-write at once): the
+        // commit's open finds a reader, and what came through can be read
+        let mut held = std::fs::OpenOptions::new().read(true).write(true).open(&fifo).unwrap();
+        check_output("--trace", &fifo).unwrap();
+        let mut file = AtomicFile::create(&fifo).unwrap();
+        file.writer().write_all(b"rows\n").unwrap();
+        file.writer().flush().unwrap();
+        assert_eq!(drain(&mut held), b"", "bytes reached the FIFO before the commit");
+        file.commit().unwrap();
+        assert_eq!(drain(&mut held), b"rows\n");
+        // a failed run's: nothing reaches it
+        let mut file = AtomicFile::create(&fifo).unwrap();
+        file.writer().write_all(b"half\n").unwrap();
+        drop(file);
+        assert_eq!(drain(&mut held), b"");
+        write_file(&fifo, "{}").unwrap();
+        assert_eq!(drain(&mut held), b"{}");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO was replaced");
+        assert_eq!(listing(&dir), ["fifo"], "no file made beside it");
+        // a socket takes no open: refused before the run, by name
+        let socket = dir.join("socket");
+        let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+        let err = check_output("--state-out", &socket).unwrap_err().to_string();
+        assert!(err.starts_with("--state-out: cannot write") && err.contains("socket"), "{err}");
+        // device nodes of our own (never the system's /dev/null): root only
+        if is_root() {
+            let (null, full) = (dir.join("null"), dir.join("full"));
+            for (node, minor) in [(&null, "3"), (&full, "7")] {
+                let made = std::process::Command::new("mknod").arg(node).args(["c", "1", minor]).status().unwrap();
+                assert!(made.success(), "mknod {}", node.display());
+            }
+            check_output("--state-out", &null).unwrap();
+            write_file(&null, "{}").unwrap();
+            let err = write_file(&full, "{}").unwrap_err().to_string();
+            assert!(err.contains("full") && err.contains("No space left"), "{err}");
+            for node in [&null, &full] {
+                assert!(std::fs::metadata(node).unwrap().file_type().is_char_device(), "{} was replaced", node.display());
+            }
+            assert_eq!(listing(&dir), ["fifo", "full", "null", "socket"]);
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_to_nothing_is_written_through_to_its_target() {
+        use std::os::unix::fs::symlink;
+        let dir = scratch("dangling");
+        let is_link = |p: &Path| std::fs::symlink_metadata(p).unwrap().file_type().is_symlink();
+        // a link to a name not there, and a chain of two: the target is made, the links stay
+        let (dangling, target) = (dir.join("dangling"), dir.join("target.json"));
+        symlink("target.json", &dangling).unwrap();
+        let (first, second, end) = (dir.join("first"), dir.join("second"), dir.join("sub").join("end.csv"));
+        std::fs::create_dir(dir.join("sub")).unwrap();
+        symlink("second", &first).unwrap();
+        symlink(&end, &second).unwrap();
+        for (link, to) in [(&dangling, &target), (&first, &end)] {
+            check_output("--state-out", link).unwrap();
+            assert!(same_file(link, to), "{} and {} are one output", link.display(), to.display());
+            write_file(link, "{}").unwrap();
+            assert!(is_link(link), "{} was replaced", link.display());
+            assert_eq!(std::fs::read_to_string(to).unwrap(), "{}");
+        }
+        assert!(is_link(&second));
+        // a link into a directory not there, and a loop: refused, and nothing changes
+        let (lost, round, about) = (dir.join("lost"), dir.join("round"), dir.join("about"));
+        symlink("no/such/dir/x.json", &lost).unwrap();
+        symlink("about", &round).unwrap();
+        symlink("round", &about).unwrap();
+        for (link, why) in [(&lost, "no directory"), (&round, "loop")] {
+            let err = check_output("--trace", link).unwrap_err().to_string();
+            assert!(err.starts_with("--trace: cannot write") && err.contains(why), "{err}");
+            assert!(write_file(link, "{}").is_err(), "{}", link.display());
+            assert!(is_link(link), "{} was replaced", link.display());
+        }
+        assert_eq!(listing(&dir), ["about", "dangling", "first", "lost", "round", "second", "sub", "target.json"]);
+        assert_eq!(listing(&dir.join("sub")), ["end.csv"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn frame_names_are_recognised() {
         assert!(is_frame_name(frame_name(0).as_ref()));
         assert!(is_frame_name(frame_name(12_345_678).as_ref()));
         for name in ["frame_1.png", "frame_000001.PNG", "frame_00000a.png", "xframe_000001.png", "frame_000001.png.tmp"] {
             assert!(!is_frame_name(name.as_ref()), "{name}");
+        }
+        for k in [0, 12, 999_999, 1_000_000, u64::MAX] {
+            assert_eq!(frame_number(frame_name(k).as_ref()), Some(k));
+        }
+        for name in ["frame_0000012.png", "frame_+00012.png", "frame_99999999999999999999.png", "frame_1.png"] {
+            assert_eq!(frame_number(name.as_ref()), None, "{name}");
         }
     }
 }

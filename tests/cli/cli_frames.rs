@@ -170,3 +170,102 @@ fn an_unwritable_frames_directory_is_refused_naming_the_flag() {
     assert_eq!(stderr.trim().lines().count(), 1, "not one line: {stderr:?}");
     let _ = std::fs::remove_file(&file);
 }
+
+#[test]
+fn a_frames_directory_that_takes_no_files_is_refused_before_the_first_step() {
+    // /proc/self is a directory in which no file can be made
+    let out = verlet(&["run", "--builtin", "drop", "--steps", "2", "--frames", "/proc/self", "--width", "8", "--height", "8"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(!stderr.contains("panicked") && !stderr.contains("note:"), "refused after the run began: {stderr}");
+    assert!(stderr.contains("--frames") && stderr.contains("/proc/self") && stderr.contains("cannot create files"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "not one line: {stderr:?}");
+}
+
+#[test]
+fn a_run_that_wrote_no_frame_says_so() {
+    // a directory where frame 0 goes: the directory takes files, but the
+    // frame cannot be put there, so the run fails at step 0
+    let dir = temp_dir("no-frame");
+    std::fs::create_dir_all(dir.join("frame_000000.png").join("inside")).unwrap();
+    let out =
+        verlet(&["run", "--builtin", "drop", "--steps", "2", "--frames", dir.to_str().unwrap(), "--width", "8", "--height", "8"]);
+    if no_adapter(&out) {
+        return;
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains(&format!("note: --frames: no frame was written to {}", dir.display())), "{stderr}");
+    assert!(!stderr.contains("no step"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn outputs_inside_the_frames_directory_it_makes_are_taken() {
+    let base = temp_dir("made");
+    std::fs::create_dir_all(&base).unwrap();
+    let d = |name: &str| base.join(name).to_str().unwrap().to_string();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", "--builtin", "drop", "--steps", "2", "--width", "8", "--height", "8"];
+        args.extend(extra);
+        verlet(&args)
+    };
+    // refused for another reason: nothing is made, not even the frames directory
+    for (extra, wanted) in [
+        (vec!["--frames", &d("a"), "--gif", &d("a/run.gif"), "--width", "100000"], "--width"),
+        (vec!["--frames", &d("b"), "--gif", &d("b/sub/run.gif")], "no directory"),
+        (vec!["--frames", &d("c"), "--gif", &d("c/frame_000001.png")], "--frames"),
+    ] {
+        let out = run(&extra);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{extra:?}: exit status 0");
+        assert!(stderr.contains(wanted) && !stderr.contains("panicked"), "{extra:?}: {stderr}");
+        assert_eq!(std::fs::read_dir(&base).unwrap().count(), 0, "{extra:?}: something was made");
+    }
+    let (dir, gif, sheet) = (d("new"), d("new/run.gif"), d("new/sheet.png"));
+    let (state, trace) = (d("new/./state.json"), d("new/trace.csv"));
+    let out = run(&["--frames", &dir, "--gif", &gif, "--contact-sheet", &sheet, "--state-out", &state, "--trace", &trace]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_000000.png", "frame_000001.png", "frame_000002.png", "run.gif", "sheet.png", "state.json", "trace.csv"]
+    );
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+#[test]
+fn frames_of_an_earlier_longer_run_are_warned_of() {
+    let dir = temp_dir("stale");
+    let d = dir.to_str().unwrap();
+    let run = |steps: &str| verlet(&["run", "--builtin", "drop", "--steps", steps, "--frames", d, "--width", "8", "--height", "8"]);
+    let out = run("5");
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"), "{}", String::from_utf8_lossy(&out.stderr));
+    // a frame-named file this run would never write counts too
+    std::fs::write(dir.join("frame_0000001.png"), b"not ours").unwrap();
+    // two frames now: frame_000002.png to frame_000005.png stay from the first run
+    let out = run("1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let warning = stderr.lines().find(|l| l.starts_with("warning: --frames")).unwrap_or_else(|| panic!("no warning: {stderr}"));
+    for wanted in [d, "5 frame files", "frame_0000001.png", "frame_000005.png"] {
+        assert!(warning.contains(wanted), "{wanted:?} not in {warning:?}");
+    }
+    // the frames are where they were: the warning changes nothing
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 7);
+    // a run as long as the first replaces all of its frames: no warning
+    std::fs::remove_file(dir.join("frame_0000001.png")).unwrap();
+    let out = run("5");
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"), "{}", String::from_utf8_lossy(&out.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -403,6 +403,115 @@ fn a_good_run_replaces_old_outputs_whole() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Makes a FIFO at `path` and opens both its ends here (Linux opens a
+/// FIFO read-write at once): a writer's open finds its reader, and
+/// [`drain_fifo`] reads what came through.
+#[cfg(unix)]
+fn held_fifo(path: &Path) -> std::fs::File {
+    assert!(Command::new("mkfifo").arg(path).status().unwrap().success(), "mkfifo {}", path.display());
+    std::fs::OpenOptions::new().read(true).write(true).open(path).unwrap()
+}
+
+/// The bytes a [`held_fifo`] holds, without waiting for more: a marker is
+/// written last and read up to.
+#[cfg(unix)]
+fn drain_fifo(held: &mut std::fs::File) -> String {
+    use std::io::{Read, Write};
+    held.write_all(b"<end>").unwrap();
+    let (mut got, mut buf) = (Vec::new(), [0u8; 4096]);
+    while !got.ends_with(b"<end>") {
+        let n = held.read(&mut buf).unwrap();
+        got.extend_from_slice(&buf[..n]);
+    }
+    got.truncate(got.len() - b"<end>".len());
+    String::from_utf8(got).unwrap()
+}
+
+#[cfg(unix)]
+#[test]
+fn a_device_or_fifo_output_is_written_into_never_replaced() {
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+    let (dir, scene, _) = workdir("special");
+    let fifo = dir.join("fifo");
+    let mut held = held_fifo(&fifo);
+    // a null device of our own (never the system's /dev/null), where root may make one
+    let null = dir.join("null");
+    let root = std::fs::metadata("/proc/self").is_ok_and(|m| m.uid() == 0);
+    let null_made = root && Command::new("mknod").arg(&null).args(["c", "1", "3"]).status().unwrap().success();
+    let mut args = vec!["run", s(&scene), "--steps", "2", "--trace", s(&fifo)];
+    if null_made {
+        args.extend(["--state-out", s(&null)]);
+    }
+    let (out, _) = capped(&args);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rows = drain_fifo(&mut held);
+    assert!(rows.starts_with(verlet::output::TRACE_HEADER), "{rows}");
+    assert_eq!(rows.lines().count(), 1 + 3, "header and steps 0, 1, 2: {rows}");
+    if null_made {
+        assert!(std::fs::metadata(&null).unwrap().file_type().is_char_device(), "the device was replaced");
+        // bench's outputs too
+        let (out, _) = capped(&[
+            "bench",
+            "--no-peer",
+            "--cases",
+            "cubes:3",
+            "--steps",
+            "2",
+            "--reps",
+            "1",
+            "--profile-steps",
+            "0",
+            "--settle-steps",
+            "0",
+            "--json",
+            s(&null),
+            "--csv",
+            s(&fifo),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(drain_fifo(&mut held).starts_with("case,"), "bench's CSV came through the FIFO");
+        assert!(std::fs::metadata(&null).unwrap().file_type().is_char_device(), "the device was replaced");
+    }
+    // a failed run writes nothing into it and makes no TRACE.partial beside it
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, flying_scene()).unwrap();
+    let before = listing(&dir);
+    let args = ["run", s(&bad), "--steps", "30", "--trace", s(&fifo)];
+    let (out, _) = capped(&args);
+    assert_refused(&args, &out, &["body 1 became absurd"]);
+    assert_eq!(drain_fifo(&mut held), "", "a failed run wrote into the FIFO");
+    assert!(stderr(&out).contains("note: --trace") && stderr(&out).contains("not kept"), "{}", stderr(&out));
+    assert_eq!(listing(&dir), before, "a file was made beside the FIFO");
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO was replaced");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(unix)]
+#[test]
+fn an_output_through_a_link_to_nothing_makes_the_links_target() {
+    let (dir, scene, _) = workdir("dangling");
+    let (link, target) = (dir.join("state.json"), dir.join("made.json"));
+    std::os::unix::fs::symlink("made.json", &link).unwrap();
+    // the link and its target are one output
+    assert_refused_quickly(
+        &["run", s(&scene), "--steps", "2", "--state-out", s(&link), "--trace", s(&target)],
+        &["--trace", "--state-out"],
+    );
+    let (out, _) = capped(&["run", s(&scene), "--steps", "2", "--state-out", s(&link)]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link was replaced");
+    let text = std::fs::read_to_string(&target).expect("the link's target is made");
+    assert_eq!(serde_json::from_str::<serde_json::Value>(&text).unwrap()["step"], 2);
+    assert_eq!(listing(&dir), ["made.json", "scene.json", "state.json"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 // ---------------------------------------------------------------------------
 // 3. Spin is checked
 // ---------------------------------------------------------------------------
