@@ -209,17 +209,8 @@ pub fn mass_problem(shape: &Shape, mass: f32) -> Option<String> {
     if !(mass.is_finite() && mass > 0.0) {
         return Some(format!("must be a positive finite number of kg, got {}", show(mass)));
     }
-    let body = Body {
-        shape: shape.clone(),
-        position: [0.0; 3],
-        orientation: [0.0, 0.0, 0.0, 1.0],
-        linear_velocity: [0.0; 3],
-        angular_velocity: [0.0; 3],
-        mass,
-        fixed: false,
-        restitution: None,
-        friction: None,
-    };
+    let mut body = Body::new(shape.clone(), [0.0; 3]);
+    body.mass = mass;
     inverse_problem(&body)
 }
 
