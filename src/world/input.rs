@@ -230,6 +230,11 @@ impl InputGpu {
     }
 }
 
+/// The most ops one dispatch of `apply_inputs` takes: the longest run of one
+/// body's ops is one invocation's loop, within lavapipe's 65535 trips with
+/// room to spare (ARCHITECTURE.md, Adding a stage, 8).
+const INPUT_BATCH: usize = 32_768;
+
 fn check_finite(name: &str, values: &[f32]) -> Result<(), Error> {
     for (k, v) in values.iter().enumerate() {
         if !v.is_finite() {
@@ -421,19 +426,23 @@ impl World {
             }
             ops.push(op);
         }
-        if ops.is_empty() {
-            return Ok(());
+        // in batches of at most INPUT_BATCH, one after the other: a body's
+        // run of ops is one loop of one invocation, and lavapipe ends such a
+        // loop at 65535 trips (70 000 impulses on one body gave 65 573 of
+        // their worth, unsaid)
+        for batch in ops.chunks_mut(INPUT_BATCH) {
+            // runs per body, in call order within each (the sort is stable)
+            batch.sort_by_key(|op| op.body);
+            let mut start = 0;
+            while start < batch.len() {
+                let end = start + batch[start..].iter().take_while(|op| op.body == batch[start].body).count();
+                batch[start].run = (end - start) as u32;
+                start = end;
+            }
+            let header = self.input_header(batch.len());
+            self.dispatch_input(&header, batch, APPLY)?;
         }
-        // runs per body, in call order within each (the sort is stable)
-        ops.sort_by_key(|op| op.body);
-        let mut start = 0;
-        while start < ops.len() {
-            let end = start + ops[start..].iter().take_while(|op| op.body == ops[start].body).count();
-            ops[start].run = (end - start) as u32;
-            start = end;
-        }
-        let header = self.input_header(ops.len());
-        self.dispatch_input(&header, &ops, APPLY)
+        Ok(())
     }
 
     fn dispatch_input(&mut self, header: &InputHeader, ops: &[InputOp], kernel: usize) -> Result<(), Error> {
