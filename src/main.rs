@@ -516,7 +516,8 @@ fn inputs_before(track: Option<&Track>, fault: &verlet::world::Fault, world: &Wo
 }
 
 /// `s` seconds with `places` decimals, or in scientific notation where
-/// those would show nothing (a step of 1e-6 s is not "0.00000 s").
+/// those would show nothing (two steps of 3e-5 s simulate 6.000e-5 s, not
+/// "0.000 s").
 fn seconds(s: f64, places: usize) -> String {
     if s != 0.0 && s.abs() < 10f64.powi(-(places as i32)) {
         format!("{s:.3e}")
