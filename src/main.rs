@@ -602,12 +602,6 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let mut world = World::with_gpu(gpu.clone(), &scene)?;
     // last of the set-up: a run refused before here makes nothing
     let mut recorder = Recorder::open(&args, &gpu, &scene)?;
-    if let Some(gif) = recorder.gif.as_mut() {
-        // browsers play a GIF's delays under 20 ms as 100 ms: frames closer
-        // than that are thinned, not shown slower (1 s at 60 Hz played in
-        // 1.22 s, 0.06 s at dt 1 ms in 1.22 s)
-        gif.at_least_apart(GIF_MIN_DELAY_MS, args.every, scene.settings.dt);
-    }
     let setup = started.elapsed();
 
     let bar = ProgressBar::with_draw_target(Some(args.steps), ProgressDrawTarget::hidden());
@@ -854,7 +848,14 @@ impl Recorder {
             }
             None => None,
         };
-        let gif = args.gif.as_ref().map(|_| Reel::new(GIF_FRAMES, GIF_BOX));
+        let gif = args.gif.as_ref().map(|_| {
+            // browsers play a GIF's delays under 20 ms as 100 ms: frames
+            // closer than that are thinned, not shown slower (1 s at 60 Hz
+            // played in 1.22 s, 0.06 s at dt 1 ms in 1.22 s)
+            let mut reel = Reel::new(GIF_FRAMES, GIF_BOX);
+            reel.at_least_apart(GIF_MIN_DELAY_MS, args.every, scene.settings.dt);
+            reel
+        });
         let sheet = args.contact_sheet.as_ref().map(|_| Reel::new(SHEET_TILES, SHEET_BOX));
         Ok(Recorder { trace, frames_dir: args.frames.clone(), gif, sheet, renderer, frames_written: 0, last_step: None })
     }
