@@ -640,7 +640,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         ));
     }
     output::write_each(writes)?;
-    let ms = wall.as_secs_f64() * 1e3 / args.steps.max(1) as f64;
+    // (no figure a step where none was taken)
+    let pace = match args.steps {
+        0 => "no step taken".to_string(),
+        n => format!("{:.3} ms/step", wall.as_secs_f64() * 1e3 / n as f64),
+    };
     outln!(
         "{} bodies, {} steps of {} s ({} s simulated) on {}",
         bodies.len(),
@@ -649,7 +653,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         seconds(world.time(), 3),
         gpu.describe()
     )?;
-    outln!("set-up {:.2} s, stepping {:.2} s ({ms:.3} ms/step, wall clock)", setup.as_secs_f64(), wall.as_secs_f64())?;
+    outln!("set-up {:.2} s, stepping {:.2} s ({pace}, wall clock)", setup.as_secs_f64(), wall.as_secs_f64())?;
     if let Some((stage_ms, timed_by_gpu)) = stage_ms {
         let source = if timed_by_gpu { "GPU timestamps" } else { "wall clock per pass" };
         outln!("per stage, ms/step ({source}):")?;

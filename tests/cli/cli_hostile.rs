@@ -701,6 +701,19 @@ fn a_track_mass_the_shape_cannot_hold_is_refused_naming_the_event() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `--steps 0` takes no step and says so, with no figure a step (it
+/// printed the set-up's time as "0.448 ms/step").
+#[test]
+fn zero_steps_give_no_figure_a_step() {
+    let out = verlet(&["run", "--builtin", "drop", "--steps", "0"]);
+    if no_adapter(&out) {
+        return;
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("0 steps of") && text.contains("(no step taken, wall clock)"), "{text}");
+    assert!(!text.contains("ms/step"), "{text}");
+}
+
 #[test]
 fn malformed_scene_files_are_named_with_the_line() {
     let (dir, _, _) = workdir("malformed");
