@@ -37,8 +37,8 @@ struct InputOp {
 // INPUT_POSE: a.xyz = position, b = unit orientation; velocities are kept
 // INPUT_VELOCITY: a.xyz = linear (m/s), b.xyz = angular (rad/s, world frame)
 // INPUT_FIXED: a.x = 1: make fixed; a.x = 0: make dynamic with mass a.y (kg),
-//   or with the mass kept when it was made fixed (kept_inv_mass) if a.y = 0
-//   (1 kg for a body loaded fixed: none kept)
+//   or with the mass kept when it was made fixed (kept_inv_mass) if a.y = 0,
+//   or for a body loaded fixed (none kept) the scene's mass, a.z
 
 // and bindings.wgsl's state_out (binding 3): the current state buffer
 @group(0) @binding(20) var<uniform> input: InputHeader;
@@ -129,10 +129,10 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 s.prev_rot = s.rot;
             } else if (fixed) {
                 // the mass given, else the one kept when an input made it
-                // fixed, else (loaded fixed: none kept) 1 kg
+                // fixed, else (loaded fixed: none kept) the scene's
                 var m = op.a.y;
                 if (m <= 0.0) {
-                    m = select(1.0, 1.0 / np.kept_inv_mass, np.kept_inv_mass > 0.0);
+                    m = select(op.a.z, 1.0 / np.kept_inv_mass, np.kept_inv_mass > 0.0);
                 }
                 np.flags = p.flags & ~FLAG_FIXED;
                 np.inv_inertia = vec4<f32>(shape_inv_inertia(p, m), 1.0 / m);

@@ -91,8 +91,9 @@ pub enum BodyInput {
     /// `fixed: true` makes the body immovable (infinite mass, at rest);
     /// `false` makes a fixed body dynamic again, at rest, with `mass` (kg)
     /// and the inertia of a solid of its shape, or with `mass: None` the mass
-    /// it had when it was made fixed. A body loaded as fixed has no mass on
-    /// record: it needs `Some(mass)` (with `None` it gets 1 kg). A mass whose
+    /// it had when it was made fixed; a body loaded as fixed then gets the
+    /// mass its scene gave it (its `mass`, or its density times its volume;
+    /// 1 kg where that mass is one its shape cannot move with). A mass whose
     /// inverse mass or inertia f32 cannot hold is refused, as a scene's is.
     Fixed { body: usize, fixed: bool, mass: Option<f32> },
 }
@@ -420,8 +421,12 @@ impl World {
                         // what the scene's own mass is checked by, for the body's shape
                         check_sane(&at("mass"), crate::scene::mass_problem(&self.scene.bodies[body].shape, m))?;
                     }
+                    // for a body loaded fixed (no mass kept on the GPU), the
+                    // mass its scene gave it, where its shape can move with it
+                    let scene = &self.scene.bodies[body];
+                    let loaded = if crate::scene::mass_problem(&scene.shape, scene.mass).is_none() { scene.mass } else { 1.0 };
                     op.kind = INPUT_FIXED;
-                    op.a = [fixed as u32 as f32, mass.unwrap_or(0.0), 0.0, 0.0];
+                    op.a = [fixed as u32 as f32, mass.unwrap_or(0.0), loaded, 0.0];
                 }
             }
             ops.push(op);

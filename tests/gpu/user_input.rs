@@ -311,14 +311,18 @@ fn switching_fixed_and_dynamic() {
     assert!(rel_err(dw, want) < 0.02, "spin change {dw:?}, want {want:?}");
 }
 
-/// A body loaded fixed has no mass kept: made dynamic without one it gets
-/// 1 kg, as `BodyInput::Fixed` says. Before, it got an infinite mass (the
-/// inverse of the 0 kept) and turned non-finite at its first contact. A
-/// mass f32 cannot invert for its shape is refused, as a scene's is.
+/// A body loaded fixed has no mass kept on the GPU: made dynamic without
+/// one it gets the mass its scene gave it (here a unit box of density 1000:
+/// 1000 kg), as `BodyInput::Fixed` says. Before, it got an infinite mass
+/// (the inverse of the 0 kept) and turned non-finite at its first contact,
+/// and then 1 kg whatever the scene said (a 2000 kg ball bounced off a
+/// stack as if off a wall). A mass f32 cannot invert for its shape is
+/// refused, as a scene's is.
 #[test]
-fn a_body_loaded_fixed_made_dynamic_without_a_mass_weighs_a_kilogram() {
+fn a_body_loaded_fixed_made_dynamic_without_a_mass_gets_its_scenes_mass() {
     let mut f = box_body([0.5; 3], [0.0, 3.0, 0.0]);
     f.fixed = true;
+    assert_eq!(f.mass, 1000.0);
     let mut sc = scene(Settings::default(), vec![f]);
     sc.ground = Some(verlet::scene::Ground { height: 0.0 });
     let Some(mut w) = world(&sc) else { return };
@@ -327,11 +331,11 @@ fn a_body_loaded_fixed_made_dynamic_without_a_mass_weighs_a_kilogram() {
         assert!(err.starts_with("mass: mass ") && err.contains("a GPU reads smaller ones as 0"), "{err}");
     }
     w.set_fixed(0, false).unwrap();
-    // 1 kg: an impulse of 2 N s along x gives 2 m/s (in the air)
-    w.apply_impulse(0, [2.0, 0.0, 0.0], None).unwrap();
+    // 1000 kg: an impulse of 2000 N s along x gives 2 m/s (in the air)
+    w.apply_impulse(0, [2000.0, 0.0, 0.0], None).unwrap();
     w.step(1).unwrap();
     let vx = w.read_state().unwrap()[0].linear_velocity[0];
-    assert!((vx - 2.0).abs() < 1e-3, "an impulse of 2 N s gave {vx} m/s: not 1 kg");
+    assert!((vx - 2.0).abs() < 1e-3, "an impulse of 2000 N s gave {vx} m/s: not 1000 kg");
     // and it lands and rests
     w.step(240).unwrap();
     assert_eq!(w.faults().unwrap(), None);
