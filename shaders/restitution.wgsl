@@ -122,8 +122,17 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         let sliding = length(v_t);
         if (pt.pushed > 0.0 && sliding > 1e-6) {
             let t = v_t / sliding;
-            let cut = min(mu * pt.pushed / params.dt, sliding / split);
-            impulse = impulse + t * (cut / (end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t)));
+            // Coulomb's bound is on the impulse: mu times the normal one,
+            // the push's velocity through the inverse mass along n (bounding
+            // the velocity change along t by mu times the push's instead
+            // left a sliding ball 3.5 times too little friction: along t
+            // its contact point moves by 1 / m + r^2 / I = 3.5 / m an
+            // impulse, along n by 1 / m; a box flat on a face has the same
+            // inverse mass both ways at its corners)
+            let w_t = end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t);
+            let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
+            let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / (split * w_t));
+            impulse = impulse + t * j;
             acted = true;
         }
         // restitution of a fast approach (approach < 0: closing), both
