@@ -86,6 +86,12 @@ fn workdir(name: &str) -> (PathBuf, PathBuf, Vec<u8>) {
     (dir, scene, text)
 }
 
+/// A bench of `cases` as short as it runs: no peer, 2 steps, 1 repetition,
+/// no profile, no settling.
+fn quick_bench(cases: &str) -> [&str; 12] {
+    ["bench", "--no-peer", "--cases", cases, "--steps", "2", "--reps", "1", "--profile-steps", "0", "--settle-steps", "0"]
+}
+
 /// The names in `dir`, sorted.
 fn listing(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> =
@@ -453,24 +459,9 @@ fn a_device_or_fifo_output_is_written_into_never_replaced() {
     if null_made {
         assert!(std::fs::metadata(&null).unwrap().file_type().is_char_device(), "the device was replaced");
         // bench's outputs too
-        let (out, _) = capped(&[
-            "bench",
-            "--no-peer",
-            "--cases",
-            "cubes:3",
-            "--steps",
-            "2",
-            "--reps",
-            "1",
-            "--profile-steps",
-            "0",
-            "--settle-steps",
-            "0",
-            "--json",
-            s(&null),
-            "--csv",
-            s(&fifo),
-        ]);
+        let mut args = quick_bench("cubes:3").to_vec();
+        args.extend(["--json", s(&null), "--csv", s(&fifo)]);
+        let (out, _) = capped(&args);
         assert!(out.status.success(), "{}", stderr(&out));
         assert!(drain_fifo(&mut held).starts_with("case,"), "bench's CSV came through the FIFO");
         assert!(std::fs::metadata(&null).unwrap().file_type().is_char_device(), "the device was replaced");
@@ -905,25 +896,7 @@ fn bench_takes_an_output_path_that_is_not_utf8() {
     use std::os::unix::ffi::OsStrExt;
     let (dir, _, _) = workdir("bench-bytes");
     let json = dir.join(std::ffi::OsStr::from_bytes(b"x\xff.json"));
-    let out = Command::new(env!("CARGO_BIN_EXE_verlet"))
-        .args([
-            "bench",
-            "--no-peer",
-            "--cases",
-            "cubes:10",
-            "--steps",
-            "2",
-            "--reps",
-            "1",
-            "--profile-steps",
-            "0",
-            "--settle-steps",
-            "0",
-        ])
-        .arg("--json")
-        .arg(&json)
-        .output()
-        .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_verlet")).args(quick_bench("cubes:10")).arg("--json").arg(&json).output().unwrap();
     if no_adapter(&out) {
         return;
     }
