@@ -143,6 +143,12 @@ fn boxes_inside_each_other(n: usize, seed: u64) -> Scene {
     weightless((0..n).map(|_| box_body([0.5; 3], at(&mut rng))).collect())
 }
 
+/// The stages that build the pair list (the grid's, then the pairs'), in
+/// the order a step runs them.
+fn pair_list_stages(w: &verlet::World) -> Vec<Stage> {
+    w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect()
+}
+
 fn weightless(bodies: Vec<verlet::Body>) -> Scene {
     Scene { settings: Settings { gravity: [0.0; 3], ..Settings::default() }, ground: None, bodies, joints: vec![], camera: None }
 }
@@ -295,8 +301,7 @@ fn the_pair_list_holds_every_pair_within_reach_once_at_any_speed() {
     let n = bodies.len();
     let scene = weightless(bodies);
     let Some(mut w) = world(&scene) else { return };
-    let stages: Vec<Stage> =
-        w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
+    let stages = pair_list_stages(&w);
     // steps, until the pair list has grown to hold the fast bodies' pairs
     let mut report = w.contact_report().unwrap();
     for _ in 0..4 {
@@ -373,8 +378,7 @@ fn boxes_placed_inside_each_other_want_every_pair() {
     let n = 600;
     let scene = boxes_inside_each_other(n, 0x5851_f42d_4c95_7f2d);
     let Some(mut w) = world(&scene) else { return };
-    let stages: Vec<Stage> =
-        w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
+    let stages = pair_list_stages(&w);
     w.run_stages(&stages).unwrap();
     let cell_start = w.read_words(Buffer::CellStart).unwrap();
     let buckets = cell_start.windows(2).filter(|c| c[1] > c[0]).count();
@@ -414,8 +418,7 @@ fn ball_over_a_floor(side: usize) -> Option<(verlet::World, verlet::world::Conta
     scene.settings.sleeping = false;
     let mut w = world(&scene)?;
     assert!(w.grid().hash_size >= 65_536, "{:?}", w.grid());
-    let stages: Vec<Stage> =
-        w.step_plan().iter().map(|&(s, _)| s).filter(|s| s.is_broadphase() || s.name().starts_with("pairs_")).collect();
+    let stages = pair_list_stages(&w);
     w.run_stages(&stages).unwrap();
     let report = w.contact_report().unwrap();
     assert!(report.pairs <= report.pair_capacity, "{report:?}");
