@@ -1,5 +1,5 @@
 // Passes "solve_contacts", "solve" and "solve_joints", run in turn
-// `iterations` times per substep: the paper's corrective snaps (eqs. 9-10).
+// in each substep its share of `iterations` times: the paper's corrective snaps (eqs. 9-10).
 // Contacts are relaxed Jacobi style. Every pose is read from state_in:
 // solve_contacts, one invocation per manifold of the pool, measures all of
 // a pair's points once and writes what they ask of each of its two bodies

@@ -156,7 +156,7 @@ pub struct CaseResult {
     pub scene: String,
     pub bodies: usize,
     pub joints: usize,
-    /// The scene's relaxation iterations per substep and substeps per step.
+    /// The scene's relaxation sweeps per step and substeps per step.
     pub iterations: u32,
     pub substeps: u32,
     /// Why the case did not run (it does not fit the adapter), if it did not.
@@ -606,11 +606,9 @@ fn render_cubes(gpu: &Arc<Gpu>) -> Result<(f64, f64), Error> {
 
 fn peer_description(opts: &Options, settings: &verlet::Settings) -> (String, String) {
     let ours = format!(
-        "ours: {} Jacobi iterations x {} substeps = {} relaxation sweeps per step by default (each case's own in its row), \
-         contacts found once per step",
-        settings.iterations,
-        settings.substeps,
-        settings.iterations * settings.substeps
+        "ours: {} Jacobi sweeps per step in {} substeps by default (each case's own in its row), contacts found once per step",
+        settings.sweeps_per_step(),
+        settings.substeps
     );
     #[cfg(feature = "rapier")]
     {
@@ -1373,13 +1371,13 @@ pub fn table(r: &Report) -> String {
     let _ = writeln!(s, "\nsanity (after the last repetition):\n");
     let _ = writeln!(
         s,
-        "| case | iterations x substeps | first step ms | set-up + 1 step s (later worlds) | mean height m | rapier mean height m | max manifolds | overflow | load avg start/end |"
+        "| case | sweeps in substeps | first step ms | set-up + 1 step s (later worlds) | mean height m | rapier mean height m | max manifolds | overflow | load avg start/end |"
     );
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---|---:|");
     for c in r.cases.iter().filter(|c| c.skipped.is_none()) {
         let _ = writeln!(
             s,
-            "| {} | {} x {} | {} | {:.2} | {:.3} | {} | {} | {} | {} |",
+            "| {} | {} in {} | {} | {:.2} | {:.3} | {} | {} | {} | {} |",
             c.case,
             c.iterations,
             c.substeps,

@@ -305,10 +305,10 @@ const MIN_POOL: u64 = 64;
 pub const PAIRS_PER_BODY: u64 = 6;
 
 /// Gauss-Seidel sweeps over the joints in a substep, spread over its
-/// `iterations` `solve_joints` passes (rounded up). A chain converges in a
+/// `solve_joints` passes, one after each relaxation sweep (rounded up). A chain converges in a
 /// few; a bridge pinned taut at both ends and loaded is the slowest case met:
 /// `bridge(20)` with ten boxes on it opens 7.3 mm with 24 sweeps a substep,
-/// 4.3 mm with 48 and 2.7 mm with 66 (64 over 3 iterations; default settings).
+/// 4.3 mm with 48 and 2.7 mm with 66 (64 over 3 sweeps; default settings).
 pub const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 /// Manifolds the pool holds per body at first (pairs with contact points;
 /// about 2.5 in a settled pile, fewer while bodies fall).
@@ -848,7 +848,7 @@ impl World {
                     substep: substep as u32,
                     opaque_zero: 0,
                     island_count: self.island_count,
-                    joint_sweeps: JOINT_SWEEPS_PER_SUBSTEP.div_ceil(s.iterations.max(1)),
+                    joint_sweeps: JOINT_SWEEPS_PER_SUBSTEP.div_ceil(s.sweeps(substep as u32)),
                 };
                 let at = slot * PARAMS_STRIDE as usize;
                 slots[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
@@ -961,7 +961,8 @@ impl World {
 
     /// The passes of one step, each with the substep whose Params it uses:
     /// the broadphase and narrowphase once, then for every substep the
-    /// integration, `iterations` sweeps of the solve's two halves and the
+    /// integration, its share of the `iterations` sweeps of the solve's two
+    /// halves (`Settings::sweeps`) and the
     /// restitution's two (the contacts, kept in the bodies' own frames,
     /// serve all substeps). A scan of at most `SCAN_SPAN` buckets or
     /// bodies is one block, which its first pass finishes: the grid's
@@ -979,7 +980,7 @@ impl World {
             Stage::ALL.iter().take_while(|s| **s != Stage::Integrate).filter(|s| needed(s)).map(|&s| (s, 0)).collect();
         for sub in 0..self.settings.substeps as usize {
             plan.push((Stage::Integrate, sub));
-            for _ in 0..self.settings.iterations {
+            for _ in 0..self.settings.sweeps(sub as u32) {
                 plan.extend([(Stage::SolveContacts, sub), (Stage::Solve, sub)]);
                 if self.island_count > 0 {
                     plan.push((Stage::SolveJoints, sub));

@@ -278,7 +278,12 @@ impl RawSettings {
             angular_damping: self.angular_damping.unwrap_or(d.angular_damping),
             restitution: self.restitution.unwrap_or(d.restitution),
             friction: self.friction.unwrap_or(d.friction),
-            substeps: self.substeps.unwrap_or(d.substeps),
+            substeps: match (self.substeps, self.iterations) {
+                (Some(n), _) => n,
+                // the solver picks the split of the sweeps a scene asks for
+                (None, Some(iterations)) => Settings::substeps_for(iterations),
+                (None, None) => d.substeps,
+            },
             sleeping: self.sleeping.unwrap_or(d.sleeping),
         })
     }

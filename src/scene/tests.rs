@@ -327,3 +327,30 @@ fn no_panic_on_truncated_or_mangled_input() {
         }
     }
 }
+
+#[test]
+fn iterations_are_the_sweeps_of_a_step_spread_over_its_substeps() {
+    let with = |iterations, substeps| Settings { iterations, substeps, ..Settings::default() };
+    let sweeps = |s: Settings| (0..s.substeps).map(|k| s.sweeps(k)).collect::<Vec<_>>();
+    // the defaults: nine sweeps in three substeps of three
+    assert_eq!(sweeps(Settings::default()), [3, 3, 3]);
+    // the first substeps take one more where they do not divide
+    assert_eq!(sweeps(with(8, 3)), [3, 3, 2]);
+    assert_eq!(sweeps(with(5, 4)), [2, 1, 1, 1]);
+    // at least one a substep
+    assert_eq!(sweeps(with(2, 4)), [1, 1, 1, 1]);
+    assert_eq!(with(2, 4).sweeps_per_step(), 4);
+    assert_eq!(with(8, 3).sweeps_per_step(), 8);
+}
+
+#[test]
+fn a_scene_that_gives_iterations_alone_gets_three_sweeps_a_substep() {
+    let substeps = |json: &str| Scene::from_json_str(json).expect("loads").settings.substeps;
+    assert_eq!(substeps(r#"{"settings": {"iterations": 8}}"#), 3);
+    assert_eq!(substeps(r#"{"settings": {"iterations": 24}}"#), 8);
+    assert_eq!(substeps(r#"{"settings": {"iterations": 1}}"#), 1);
+    assert_eq!(substeps(r#"{"settings": {"iterations": 256}}"#), 64);
+    // a scene's own substeps stand; none at all: the default
+    assert_eq!(substeps(r#"{"settings": {"iterations": 8, "substeps": 8}}"#), 8);
+    assert_eq!(substeps(r#"{"settings": {}}"#), Settings::default().substeps);
+}

@@ -75,8 +75,9 @@ pub fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
 
 /// Refuses a step so long that bodies would rest visibly inside the ground,
 /// or sink through it. Gravity moves a body |g| h^2 into whatever it rests
-/// on every substep of h, and `iterations` Jacobi sweeps relaxed by c_r
-/// take back all but (1 - c_r)^iterations of it, so that much stays inside,
+/// on every substep of h, and the substep's k Jacobi sweeps relaxed by c_r
+/// take back all but (1 - c_r)^k of it (k the fewest sweeps a substep
+/// takes, `Settings::sweeps`), so that much stays inside,
 /// every substep, and a body rests (and falls asleep) there: measured, unit
 /// cubes came to rest 6 mm inside the ground at dt 0.2 s, 39 mm at 0.5 s
 /// and 156 mm at 1 s (3 substeps, 3 sweeps, c_r 0.5), as the formula says.
@@ -85,7 +86,7 @@ pub fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
 /// out at no more than `MAX_DEPENETRATION_SPEED` (3 m/s) times h: where
 /// more stays, it adds up and the body sinks through the ground. Measured
 /// at the default dt, a unit box rested 2.7 cm inside at 5000 m/s^2 and
-/// fell through at 6000 (1.2 m below in 4 s), where (1 - c_r)^iterations
+/// fell through at 6000 (1.2 m below in 4 s), where (1 - c_r)^k
 /// |g| h is 3.5 and 4.2 m/s; this refuses from 3 m/s (4320 m/s^2 there).
 /// Only gravity's part into the ground (along -y) counts: sideways or
 /// upward it presses nothing into it.
@@ -96,7 +97,8 @@ pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError
     use crate::world::MAX_DEPENETRATION_SPEED;
     let h = s.dt as f64 / s.substeps as f64;
     let g = (-s.gravity[1] as f64).max(0.0);
-    let left = (1.0 - s.relaxation as f64).powi(s.iterations as i32);
+    let sweeps = s.sweeps(s.substeps.max(1) - 1);
+    let left = (1.0 - s.relaxation as f64).powi(sweeps as i32);
     let sink = left * g * h * h;
     let limit = 0.1 * smallest as f64;
     let speed = left * g * h;
@@ -111,7 +113,7 @@ pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError
         g * h * h,
         show(s.dt),
         s.substeps,
-        s.iterations,
+        sweeps,
         show(s.relaxation)
     );
     let why = if sink > limit {

@@ -8,7 +8,7 @@
 //!    clips the face contacts, over the top run of the pool
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl), after
 //!    applying the last substep's restitution in a step's later substeps
-//! 5. `solve_contacts`, `solve`, `solve_joints` — `iterations` sweeps of corrective snaps:
+//! 5. `solve_contacts`, `solve`, `solve_joints` — the substep's share of the `iterations` sweeps of corrective snaps:
 //!    per manifold what it asks of its bodies, then per body the sum (Jacobi), then per
 //!    joint island its joints in turn (Gauss-Seidel; only in scenes with joints)
 //!    (shaders/solve.wgsl)
