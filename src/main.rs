@@ -1138,8 +1138,7 @@ fn info() -> Result<(), Error> {
     outln!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu))?;
     if i.name.contains("llvmpipe") {
         // lavapipe hands every dispatch to its worker threads, and that
-        // hand-off is most of a small scene's step (README: "On a software
-        // adapter")
+        // hand-off is most of a small scene's step (docs/lavapipe.md)
         let threads =
             std::env::var("LP_NUM_THREADS").map_or("LP_NUM_THREADS unset: its default".into(), |t| format!("LP_NUM_THREADS={t}"));
         outln!(
