@@ -1,4 +1,4 @@
-//! Ball joints (issue 4): a chain that swings and comes to rest, a pendulum
+//! Ball joints: a chain that swings and comes to rest, a pendulum
 //! with the compound-pendulum period, a loaded bridge, ragdolls on a pile.
 
 use crate::common::{quat, v3, world};
@@ -57,7 +57,7 @@ fn a_chain_of_21_links_swings_and_comes_to_rest_hanging() {
 }
 
 /// The settings a user's scene gets: the defaults, or the interface's
-/// suggested `iterations` 8 (issue 14: joints must hold under both).
+/// suggested `iterations` 8 (joints must hold under both).
 const USER_SETTINGS: [(&str, u32); 2] = [("default", 3), ("suggested iterations 8", 8)];
 
 fn user_settings(mut scene: Scene, iterations: u32) -> Scene {
@@ -109,7 +109,7 @@ fn loaded_bridge() -> Scene {
     scene
 }
 
-/// Issue 14 part 2: a user's chain, loaded bridge and ragdolls, with the
+/// A user's chain, loaded bridge and ragdolls, with the
 /// default settings and with the suggested ones, keep every joint within
 /// 5 mm after the first second (sampled every step for 5 s: the chain's
 /// swing through its lowest point, the boxes landing on the bridge, the
@@ -235,7 +235,7 @@ fn fastest_over(scene: &Scene, steps: u32) -> Option<(f32, f32)> {
     Some((fastest, widest))
 }
 
-/// Issue 16: joint error a scene starts with is closed at a bounded speed,
+/// Joint error a scene starts with is closed at a bounded speed,
 /// as overlap is (3 m/s a joint), not snapped shut in one substep, and
 /// joints that cannot all close do not throw or spin bodies. No gravity:
 /// only the joints move anything.
