@@ -969,7 +969,7 @@ fn help_lists_every_built_in_scene() {
 
 #[test]
 fn two_bodies_placed_in_one_spot_separate_no_faster_than_promised() {
-    // The README's promise: old overlap between two bodies is pushed out at
+    // docs/defaults.md's promise ("Contacts"): old overlap between two bodies is pushed out at
     // most 3 m/s. (Many bodies in one spot add their pairs' speeds up: ten
     // boxes spread at 13 m/s.)
     let cube = || scenes::box_body([0.5; 3], [0.0, 2.0, 0.0]);
