@@ -6,7 +6,8 @@
 //! ```
 //!
 //! Drops 64 unit cubes in four layers (the `pile` scene), steps 2.5 s and
-//! writes a 480 x 320 frame every 1/6 s to `OUT_DIR/frame_NNN.png`.
+//! writes a 480 x 320 frame every 1/6 s to `OUT_DIR/frame_000000.png`, ...
+//! (the names `verlet run --frames` gives).
 
 mod common;
 
@@ -28,7 +29,7 @@ fn main() -> std::process::ExitCode {
         let mut renderer = Renderer::new(world.gpu(), &scene, 480, 320)?;
         loop {
             let frame = world.step_count() / EVERY;
-            let path = out.join(format!("frame_{frame:03}.png"));
+            let path = out.join(verlet::output::frame_name(frame));
             render::write_png(&renderer.render(&world)?, &path)?;
             if world.step_count() >= STEPS {
                 break;

@@ -61,8 +61,10 @@ impl Case {
         if !scenes::NAMES.iter().any(|(n, _)| *n == scene) {
             let named: Vec<&str> = CASES.iter().map(|c| c.0).collect();
             let known: Vec<&str> = scenes::NAMES.iter().map(|c| c.0).collect();
+            let all: Vec<&str> = named.iter().chain(&known).copied().collect();
+            let guess = scenes::closest(spec, &all).map_or(String::new(), |g| format!(" (did you mean {g}?)"));
             return Err(Error::Input(format!(
-                "--cases: unknown case {spec:?}; named cases: {}; or SCENE[:COUNT] with SCENE one of {}",
+                "--cases: unknown case {spec:?}{guess}; named cases: {}; or SCENE[:COUNT] with SCENE one of {}",
                 named.join(", "),
                 known.join(", ")
             )));

@@ -50,3 +50,14 @@ pub enum Error {
     #[error("{path}: {source}")]
     Io { path: String, source: std::io::Error },
 }
+
+/// The README's Rust example, compiled by `cargo test` as a doctest so that
+/// it stays true to the library.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
+/// `docs/library.md`'s program, compiled as the README's is.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/library.md")]
+pub struct LibraryDoctests;

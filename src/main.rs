@@ -108,7 +108,7 @@ struct BenchArgs {
     /// A short run: fewer cases, steps and repetitions.
     #[arg(long)]
     quick: bool,
-    /// Steps timed stage by stage after the repetitions (default 10; 3 with --quick; 0: none, and no render and no cold-start runs).
+    /// Steps timed stage by stage after the repetitions (default 10; 3 with --quick; 0: none).
     #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     profile_steps: Option<u64>,
     /// Write the full report as JSON here.
@@ -134,9 +134,28 @@ struct BenchArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     rapier_iterations: Option<usize>,
     /// Most steps the largest pile case of at most 10k bodies takes to come to
-    /// rest, with sleeping on, for the memory of a settled pile (default 1800; 0: not settled).
+    /// rest, with sleeping on, for the memory of a settled pile (default 1800
+    /// with --settle; given alone, it asks for --settle; 0: not settled).
     #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
     settle_steps: Option<u64>,
+    /// Also bring the largest pile case of at most 10k bodies to rest and
+    /// report the memory a settled pile holds.
+    #[arg(long)]
+    settle: bool,
+    /// Also time whole processes starting with Mesa's shader cache disabled
+    /// (`verlet run --builtin cubes --count 10 --steps 1`; 3 runs, 1 with --quick).
+    #[arg(long)]
+    cold_start: bool,
+    /// Also time an off-screen render of the 1000-cube scene at 640 x 480.
+    #[arg(long)]
+    render: bool,
+    /// Also time ten cubes' steps over the dispatches of a step: what a
+    /// dispatch costs before any work.
+    #[arg(long)]
+    dispatch_cost: bool,
+    /// All of --settle, --cold-start, --render and --dispatch-cost.
+    #[arg(long)]
+    all: bool,
 }
 
 #[derive(clap::Args)]
@@ -152,8 +171,11 @@ struct RunArgs {
     /// --seed of the built-in scene (1 if not given).
     #[arg(long, requires = "builtin", allow_negative_numbers = true, value_parser = whole_u64)]
     seed: Option<u64>,
-    /// Steps to take.
-    #[arg(long, allow_negative_numbers = true, value_parser = whole_u64)]
+    /// Steps to take (required).
+    #[arg(long = "steps", value_name = "STEPS", allow_negative_numbers = true, value_parser = whole_u64)]
+    steps_given: Option<u64>,
+    /// `--steps` once `run` has checked it was given.
+    #[arg(skip)]
     steps: u64,
     /// A scripted input track (JSON: impulses, explosions, poses,
     /// velocities, fixed switches, wind at given times) applied between
@@ -285,6 +307,12 @@ fn bench(a: BenchArgs) -> Result<(), verlet::Error> {
         peer_max_bodies: a.peer_max_bodies,
         rapier_sleeping: a.rapier_sleeping,
         settle_steps: a.settle_steps,
+        extras: harness::Extras {
+            settle: a.settle || a.all,
+            cold_start: a.cold_start || a.all,
+            render: a.render || a.all,
+            dispatch_cost: a.dispatch_cost || a.all,
+        },
         rapier_iterations: a.rapier_iterations,
         command: std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect::<Vec<_>>().join(" "),
     })?;
@@ -534,7 +562,35 @@ fn partial_path(trace: &Path) -> PathBuf {
     PathBuf::from(partial)
 }
 
-fn run(args: RunArgs) -> Result<(), Error> {
+/// How `verlet run` is called, for an error that finds the scene or
+/// `--steps` missing: one round trip to a working command.
+const RUN_USAGE: &str = "usage: verlet run SCENE.json --steps N [OPTIONS], or verlet run --builtin NAME --steps N [OPTIONS] \
+                         (`verlet run --help` lists the options and the built-in scenes)";
+
+/// `--steps` and the scene, both of which a run needs, named together
+/// when either is missing, with the usage.
+fn check_required(args: &mut RunArgs) -> Result<(), Error> {
+    let scene = args.scene.is_some() || args.builtin.is_some();
+    match (args.steps_given, scene) {
+        (Some(steps), true) => {
+            args.steps = steps;
+            Ok(())
+        }
+        (None, false) => Err(Error::Input(format!("missing a scene (SCENE.json or --builtin NAME) and --steps N; {RUN_USAGE}"))),
+        (None, true) => Err(Error::Input(format!("missing --steps N, the number of steps to take; {RUN_USAGE}"))),
+        (Some(_), false) => Err(Error::Input(format!("missing a scene: give a scene file or --builtin NAME; {RUN_USAGE}"))),
+    }
+}
+
+/// `n` and the noun, singular for one (`1 body`, `2 bodies`).
+fn counted(n: impl Into<u64>, one: &str, many: &str) -> String {
+    let n = n.into();
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+fn run(mut args: RunArgs) -> Result<(), Error> {
+    check_required(&mut args)?;
+    let args = args;
     // Everything the user gave is checked before the GPU is touched, and a
     // built-in scene's size before it is built.
     if let Some(dt) = args.dt {
@@ -569,7 +625,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
             warn_unused_seed(name, args.seed);
             (None, scenes::check(name, args.count, scenes::MAX_BODIES)?)
         }
-        (None, None) => return Err(Error::Input("give a scene file or --builtin NAME".into())),
+        (None, None) => return Err(Error::Input(format!("missing a scene: give a scene file or --builtin NAME; {RUN_USAGE}"))),
     };
     let track = match (&args.input, args.builtin.as_deref()) {
         (Some(path), _) => Some(load_track(path)?),
@@ -593,7 +649,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
             with_dt(&mut scene, args.dt)?;
             scene
         }
-        (None, None) => return Err(Error::Input("give a scene file or --builtin NAME".into())),
+        (None, None) => return Err(Error::Input(format!("missing a scene: give a scene file or --builtin NAME; {RUN_USAGE}"))),
     };
     if let Some(track) = &track {
         track.check_masses(&scene)?;
@@ -630,6 +686,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
     };
     let wall = started.elapsed();
     let frames_written = recorder.frames_written;
+    let (gif_frames, sheet_frames) = (recorder.gif.as_ref().map_or(0, Reel::len), recorder.sheet.as_ref().map_or(0, Reel::len));
     let state_json = args.state_out.as_ref().map(|_| output::state_json(world.step_count(), world.time(), &bodies));
     let mut writes = recorder.finish(&args, scene.settings.dt);
     if let (Some(path), Some(text)) = (&args.state_out, &state_json) {
@@ -646,9 +703,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
         n => format!("{:.3} ms/step", wall.as_secs_f64() * 1e3 / n as f64),
     };
     outln!(
-        "{} bodies, {} steps of {} s ({} s simulated) on {}",
-        bodies.len(),
-        world.step_count(),
+        "{}, {} of {} s ({} s simulated) on {}",
+        counted(bodies.len() as u64, "body", "bodies"),
+        counted(world.step_count(), "step", "steps"),
         seconds(scene.settings.dt as f64, 5),
         seconds(world.time(), 3),
         gpu.describe()
@@ -657,23 +714,31 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if let Some((stage_ms, timed_by_gpu)) = stage_ms {
         let source = if timed_by_gpu { "GPU timestamps" } else { "wall clock per pass" };
         outln!("per stage, ms/step ({source}):")?;
+        // the longest stage name sets the column (`restitution_contacts` broke a fixed one)
+        let width = stage_ms.iter().map(|(stage, _)| stage.name().len()).max().unwrap_or(0);
         for (stage, total) in &stage_ms {
-            outln!("  {:<18} {:>9.3}", stage.name(), total / args.steps.max(1) as f64)?;
+            outln!("  {:<width$}  {:>9.3}", stage.name(), total / args.steps.max(1) as f64)?;
         }
     }
     if let Some(dir) = &args.frames {
-        outln!("{frames_written} frames in {}", dir.display())?;
+        outln!("{} in {}", counted(frames_written, "frame", "frames"), dir.display())?;
+    }
+    for (what, path, count) in [("GIF", &args.gif, gif_frames), ("contact sheet", &args.contact_sheet, sheet_frames)] {
+        if let Some(path) = path {
+            outln!("{what} of {} in {}", counted(count as u64, "frame", "frames"), path.display())?;
+        }
     }
     let report = world.contact_report()?;
     if args.profile {
+        // the pools shrink after busy steps, so the busiest step may have
+        // wanted more than they hold now without anything lost
+        outln!("contacts, last step:    {} candidate pairs, {} manifolds", report.pairs, report.manifolds)?;
+        outln!("contacts, busiest step: {} candidate pairs, {} manifolds", report.pairs_max, report.manifolds_max)?;
         outln!(
-            "contacts in the last step: {} candidate pairs, {} manifolds (most in a step: {}, {}; room for {}, {})",
-            report.pairs,
-            report.manifolds,
-            report.pairs_max,
-            report.manifolds_max,
+            "contact pools now:      room for {} candidate pairs, {} manifolds (they grow when a step nearly fills them and shrink after quiet steps{})",
             report.pair_capacity,
-            report.manifold_capacity
+            report.manifold_capacity,
+            if report.overflowed() { "; some overflowed: see the warning" } else { "; none overflowed" }
         )?;
     }
     if report.overflowed() {
@@ -706,10 +771,18 @@ fn run(args: RunArgs) -> Result<(), Error> {
         };
         let (moving, speed) = fastest(|b| b.linear_velocity);
         let (spinning, spin) = fastest(|b| b.angular_velocity);
-        outln!(
-            "lowest body {lowest} at y = {:.3} m; fastest body {speed:.3} m/s (body {moving}); fastest spin {spin:.3} rad/s (body {spinning})",
-            b.position[1]
-        )?;
+        // a body is named only where one moves: "(body 0)" of a still scene
+        // named a body for nothing
+        // (what prints as 0.000 counts as still)
+        let motion = match (speed >= 0.0005, spin >= 0.0005) {
+            (false, false) => "nothing moves (fastest body 0.000 m/s, fastest spin 0.000 rad/s)".to_string(),
+            (true, false) => format!("fastest body {speed:.3} m/s (body {moving}); no body spins (fastest spin 0.000 rad/s)"),
+            (false, true) => format!("no body moves (fastest body 0.000 m/s); fastest spin {spin:.3} rad/s (body {spinning})"),
+            (true, true) => {
+                format!("fastest body {speed:.3} m/s (body {moving}); fastest spin {spin:.3} rad/s (body {spinning})")
+            }
+        };
+        outln!("lowest body {lowest} at y = {:.3} m; {motion}", b.position[1])?;
     }
     if world.at_rest() {
         outln!("at rest: every body asleep or fixed; steps from then on change nothing and were counted, not run")?;
@@ -1017,6 +1090,11 @@ impl Reel {
         self.stride = (ms / (every as f64 * dt as f64 * 1e3)).ceil().max(1.0) as u64;
     }
 
+    /// How many frames `finish` gives.
+    fn len(&self) -> usize {
+        self.kept.len() + usize::from(self.latest.is_some())
+    }
+
     fn finish(self) -> Vec<RgbaImage> {
         let mut frames = self.kept;
         frames.extend(self.latest);
@@ -1060,8 +1138,7 @@ fn info() -> Result<(), Error> {
     outln!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu))?;
     if i.name.contains("llvmpipe") {
         // lavapipe hands every dispatch to its worker threads, and that
-        // hand-off is most of a small scene's step (README: "On a software
-        // adapter")
+        // hand-off is most of a small scene's step (docs/lavapipe.md)
         let threads =
             std::env::var("LP_NUM_THREADS").map_or("LP_NUM_THREADS unset: its default".into(), |t| format!("LP_NUM_THREADS={t}"));
         outln!(

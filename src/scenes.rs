@@ -349,7 +349,8 @@ pub fn body_count(name: &str, count: Option<usize>) -> Option<u64> {
 pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, Error> {
     let Some(bodies) = body_count(name, count) else {
         let names: Vec<&str> = NAMES.iter().map(|(n, _)| *n).collect();
-        return Err(Error::Input(format!("unknown scene {name:?}; known: {}", names.join(", "))));
+        let guess = closest(name, &names).map_or(String::new(), |g| format!("; did you mean {g}?"));
+        return Err(Error::Input(format!("unknown scene {name:?}{guess} (known: {})", names.join(", "))));
     };
     if let Some(count) = count {
         let min = min_count(name);
@@ -374,6 +375,42 @@ pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, E
         return Err(Error::Capacity(format!("--count: the {name} scene with {what} has {has}, but {limit}")));
     }
     Ok(bodies)
+}
+
+/// The one of `known` nearest to a mistyped `word`: within two edits
+/// (insert, delete, replace, or swap two neighbours), ignoring case, and
+/// nearer than any other. `None` when nothing is that near or two tie.
+pub fn closest<'a>(word: &str, known: &[&'a str]) -> Option<&'a str> {
+    let word: Vec<char> = word.to_lowercase().chars().collect();
+    let mut scored: Vec<(usize, &str)> =
+        known.iter().map(|k| (edits(&word, &k.to_lowercase().chars().collect::<Vec<_>>()), *k)).collect();
+    scored.sort_by_key(|s| s.0);
+    match scored.as_slice() {
+        [(d, best), rest @ ..] if *d <= 2 && rest.first().is_none_or(|next| next.0 > *d) => Some(best),
+        _ => None,
+    }
+}
+
+/// Edits from `a` to `b` (optimal string alignment distance).
+fn edits(a: &[char], b: &[char]) -> usize {
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut best = (d[i - 1][j] + 1).min(d[i][j - 1] + 1).min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                best = best.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = best;
+        }
+    }
+    d[a.len()][b.len()]
 }
 
 /// The named scene, after [`check`] against `max_bodies`.
@@ -427,5 +464,20 @@ impl SplitMix64 {
         let tau = std::f32::consts::TAU;
         let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
         [a * (tau * u2).sin(), a * (tau * u2).cos(), b * (tau * u3).sin(), b * (tau * u3).cos()]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::closest;
+
+    #[test]
+    fn a_mistyped_name_finds_the_one_meant() {
+        let names: Vec<&str> = super::NAMES.iter().map(|(n, _)| *n).collect();
+        assert_eq!(closest("pyramd", &names), Some("pyramid"));
+        assert_eq!(closest("Stakc", &names), Some("stack"));
+        assert_eq!(closest("ragdol", &names), Some("ragdoll"));
+        assert_eq!(closest("teapot", &names), None, "nothing near");
+        assert_eq!(closest("ab", &["ax", "ay"]), None, "two as near: no guess");
     }
 }

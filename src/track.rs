@@ -1,4 +1,4 @@
-//! Scripted input tracks (issue 8, part 3): user input replayed headless by
+//! Scripted input tracks: user input replayed headless by
 //! `verlet run SCENE --input TRACK.json`, or by a program between steps.
 //!
 //! A track is a JSON object with one list, `events`; each event has a time

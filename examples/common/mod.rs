@@ -31,11 +31,9 @@ fn io_error(path: &Path, source: std::io::Error) -> verlet::Error {
     verlet::Error::Io { path: path.display().to_string(), source }
 }
 
-/// Runs `example` after quieting the window-system probe (before any
-/// thread starts, as it asks), and prints its error, if any, as `verlet`
-/// does: one line, a failure exit status.
+/// Runs `example` and prints its error, if any, as `verlet` does: one
+/// line, a failure exit status.
 pub fn main(example: impl FnOnce() -> Result<(), verlet::Error>) -> ExitCode {
-    verlet::gpu::quiet_window_system_probe();
     match example() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

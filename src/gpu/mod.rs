@@ -130,6 +130,9 @@ impl Gpu {
         // wgpu skips names it does not know, and with none left finds no
         // adapter at all: say which variable is wrong instead
         check_env()?;
+        // before the instance enumerates adapters, where the noise comes from
+        static QUIET: std::sync::Once = std::sync::Once::new();
+        QUIET.call_once(quiet_window_system_probe);
         // wgpu checks the size of every indirect dispatch on the GPU before
         // it runs, with a dispatch of its own: 29 a step at the defaults
         // (the narrowphase's, the contact passes' and the body passes'),
@@ -288,10 +291,10 @@ impl Gpu {
 
 /// Keeps a headless run from printing libwayland's `error: XDG_RUNTIME_DIR
 /// is invalid or not set in the environment.` (twice) when it opens the
-/// GPU. Call it first thing in `main`, before any thread starts: it may set
-/// an environment variable, which is only sound while one thread runs
-/// (`verlet`'s `main` and the examples do; [`Gpu::new`] does not, since a
-/// library cannot know it is alone).
+/// GPU. [`Gpu::new`] calls it (once a process), so a program using the
+/// library is quiet without knowing of it; calling it first thing in
+/// `main` as well is harmless, and the soundest: it may set an environment
+/// variable, which is best done while one thread runs.
 ///
 /// Why: wgpu-hal 30 enables every window-system surface extension the
 /// Vulkan loader offers (`VK_KHR_wayland_surface` among them,
@@ -310,12 +313,16 @@ impl Gpu {
 ///
 /// What it costs: nothing is hidden but that line (stderr stays as it
 /// is), the variable is set only in that case, and this process's children
-/// inherit `WAYLAND_DISPLAY=/dev/null` (verlet starts none). A libwayland
-/// too old to take an absolute `WAYLAND_DISPLAY` still prints the line
-/// (Debian 12's 1.21 takes it). Other ways and why not: `NODEVICE_SELECT=1` turns the
-/// whole layer off (and with it `MESA_VK_DEVICE_SELECT` and `DRI_PRIME`);
-/// a made-up `XDG_RUNTIME_DIR` would have to be created, kept private and
-/// removed, and other libraries put files there.
+/// inherit `WAYLAND_DISPLAY=/dev/null`. A libwayland too old to take an
+/// absolute `WAYLAND_DISPLAY` still prints the line (Debian 12's 1.21
+/// takes it). Rust's own reads of the environment wait on std's lock while
+/// it is set; only C code reading it on another thread at that instant
+/// could race, so a program that starts such threads before its first
+/// [`Gpu`] calls this first in `main`. Other ways and why not:
+/// `NODEVICE_SELECT=1` turns the whole layer off (and with it
+/// `MESA_VK_DEVICE_SELECT` and `DRI_PRIME`); a made-up `XDG_RUNTIME_DIR`
+/// would have to be created, kept private and removed, and other libraries
+/// put files there; filtering stderr would hide other threads' lines.
 pub fn quiet_window_system_probe() {
     if cfg!(all(unix, not(target_os = "macos"), not(target_os = "android"))) {
         let absolute = |var: &str| std::env::var_os(var).is_some_and(|v| v.as_encoded_bytes().first() == Some(&b'/'));

@@ -1,4 +1,4 @@
-//! A scene beyond the adapter's limits (issue 7, part 1) given to the
+//! A scene beyond the adapter's limits given to the
 //! command line: a non-zero exit and a one-line reason, no panic.
 
 use std::process::Command;

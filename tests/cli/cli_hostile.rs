@@ -1,4 +1,4 @@
-//! Careless and hostile use (issue 16): every case is refused with a
+//! Careless and hostile use: every case is refused with a
 //! non-zero exit, no panic, a message naming the flag, field or file, and
 //! nothing of the user's destroyed or half-written. Refusals that must come
 //! before any scene is built are timed (a generous bound: it asserts that no
@@ -907,7 +907,7 @@ fn bench_takes_an_output_path_that_is_not_utf8() {
 }
 
 // ---------------------------------------------------------------------------
-// 5. A quiet doorstep (issue 15)
+// 5. A quiet doorstep
 // ---------------------------------------------------------------------------
 
 /// Variables set, and variables removed, for a child.
@@ -969,9 +969,9 @@ fn help_lists_every_built_in_scene() {
 
 #[test]
 fn two_bodies_placed_in_one_spot_separate_no_faster_than_promised() {
-    // The README's promise: old overlap between two bodies is pushed out at
+    // docs/defaults.md's promise ("Contacts"): old overlap between two bodies is pushed out at
     // most 3 m/s. (Many bodies in one spot add their pairs' speeds up: ten
-    // boxes spread at 13 m/s; see the issue's notes.)
+    // boxes spread at 13 m/s.)
     let cube = || scenes::box_body([0.5; 3], [0.0, 2.0, 0.0]);
     for (name, second) in [("two boxes", cube()), ("a box and a ball", scenes::sphere_body(0.5, [0.0, 2.0, 0.0]))] {
         let mut scene = scenes::stack(0);

@@ -6,6 +6,7 @@
 mod common;
 
 mod cli_capacity;
+mod cli_doorstep;
 mod cli_frames;
 mod cli_hostile;
 mod cli_info;

@@ -1,4 +1,4 @@
-//! Memory and capacity (issue 3, part 6): a scene beyond the adapter's limits
+//! Memory and capacity: a scene beyond the adapter's limits
 //! is refused before any allocation; the pair list grows for a crowded scene.
 
 use glam::Vec3;

@@ -1,4 +1,4 @@
-//! Determinism (issue 7, part 5): a canonical scene's state after N steps
+//! Determinism: a canonical scene's state after N steps
 //! hashes to a pinned value on lavapipe, and two separate processes write
 //! byte-identical state files.
 
@@ -16,7 +16,7 @@ const STEPS: u64 = 300;
 /// once per sweep for both bodies (solve_contacts, restitution_contacts)
 /// and each body sums what its manifolds ask, and the pair walk visits half
 /// the neighbour cells, which reorders the pairs, so the float sums round
-/// differently. Re-pinned again for the displacement state (issue 14): the
+/// differently. Re-pinned again for the displacement state: the
 /// pose holds x_n - x_(n-1) and a rounding remainder instead of the previous
 /// position (different bytes hashed, and integrate, the snaps and
 /// restitution now round differently). Re-pinned for the separating-axis

@@ -1,4 +1,4 @@
-//! Device faults (issue 7, part 4): a device destroyed in the middle of a
+//! Device faults: a device destroyed in the middle of a
 //! run makes the library return errors, never panic or hang.
 
 use std::sync::{mpsc, Arc};

@@ -1,4 +1,4 @@
-//! Numerical faults (issue 7, part 3): the GPU flags, every step and with no
+//! Numerical faults: the GPU flags, every step and with no
 //! readback, a body whose state is non-finite or absurd (beyond 1e6 m or
 //! 1e4 m/s); the library reports which body and which step, the body is
 //! stopped at its last sane pose, the others go on untouched, and

@@ -1,4 +1,4 @@
-//! Scripted input tracks (issue 8, parts 3 and 4): loading and refusing
+//! Scripted input tracks: loading and refusing
 //! track files naming the field, events applied at their step and not
 //! before, `verlet run --input`, and the built-in `blast` scene with its
 //! default track.

@@ -1,4 +1,4 @@
-//! Many bodies colliding (issue 3): piles settle, stacks and pyramids stand,
+//! Many bodies colliding: piles settle, stacks and pyramids stand,
 //! fast bodies meet walls, friction holds on a ramp, runs repeat bit for bit.
 
 use crate::common::{quat, v3, world};
@@ -70,8 +70,8 @@ fn a_thousand_cubes_fall_and_settle() {
     assert!(!report.overflowed(), "contact lists overflowed: {report:?}");
 }
 
-/// 1000 cubes that land on each other, three and four deep: the floor of
-/// the issue for a real pile. With sleeping (the default) the pile comes to
+/// 1000 cubes that land on each other, three and four deep: a real pile.
+/// With sleeping (the default) the pile comes to
 /// rest, and the pair list and manifold pool grow to hold every pair.
 #[test]
 fn a_thousand_cubes_piled_four_deep_settle() {
@@ -198,7 +198,7 @@ fn an_imperfect_pyramid_of_ten_rows_stands() {
     assert!(moved < 0.05, "a box moved {moved} m");
 }
 
-/// Issue 14 part 3: a column of 20 boxes placed imperfectly stands 10 s
+/// A column of 20 boxes placed imperfectly stands 10 s
 /// with the default settings: its top drifts under 3 cm sideways and it
 /// never sinks 5 cm (sampled every step). Before the lower body of a
 /// stacked pair counted less (SHOCK in solve.wgsl) it leaned 125 cm.
@@ -219,7 +219,7 @@ fn an_imperfect_column_of_twenty_boxes_stands() {
     assert!(sank < 0.05, "the column sank {sank} m");
 }
 
-/// Issue 14 part 3: a 20-row pyramid placed imperfectly (210 boxes).
+/// A 20-row pyramid placed imperfectly (210 boxes).
 #[test]
 fn an_imperfect_pyramid_of_twenty_rows_stands() {
     let scene = imperfect(scenes::pyramid(20));
@@ -230,7 +230,7 @@ fn an_imperfect_pyramid_of_twenty_rows_stands() {
     assert!(moved < 0.05, "a box moved {moved} m");
 }
 
-/// Issue 14 part 3: a 30-row pyramid placed imperfectly (465 boxes) moves
+/// A 30-row pyramid placed imperfectly (465 boxes) moves
 /// no box more than 5 cm in 10 s. Its top box used to be thrown half a
 /// metre up in the first half second (the rows' pushes out of the overlap
 /// the sweeps' lag had let in, all turned into velocity: solve.wgsl's
@@ -460,7 +460,7 @@ fn same_scene_same_bits() {
     assert!(bytemuck::cast_slice::<_, u8>(&first) == bytemuck::cast_slice::<_, u8>(&second), "two runs differ");
 }
 
-/// Issue 16 part 3: bodies placed inside each other part at about 3 m/s at
+/// Bodies placed inside each other part at about 3 m/s at
 /// most, however many share one point, and end apart (measured: 0.33, 1.6,
 /// 3.15, 2.4 and 1.3 m/s for the cases below). Each contact pushes
 /// old overlap out at no more than 3 m/s, and overlap older and deeper than

@@ -1,4 +1,4 @@
-//! Known answers for the integrator and the ground contacts (issue 2).
+//! Known answers for the integrator and the ground contacts.
 
 use crate::common::{quat, v3, world};
 use glam::{DVec3, Quat, Vec3};
@@ -79,7 +79,7 @@ fn parabola_errors(starts: &[[f32; 3]], v0: [f32; 3], substeps: u32) -> Option<V
     Some(worst)
 }
 
-// Issue 14: Verlet kept as pos - prev_pos lost the velocity's low bits far
+// Verlet kept as pos - prev_pos lost the velocity's low bits far
 // from the origin (155 mm off at 100 m up); the displacement and the
 // position's rounding remainder (common.wgsl, BodyState) keep every start
 // on its parabola. The launch has a component along every axis, so no
@@ -108,7 +108,7 @@ fn projectiles_far_from_the_origin_stay_on_their_parabolas() {
     }
 }
 
-// Issue 16 part 5: the state and the trace report velocities at the step's
+// The state and the trace report velocities at the step's
 // time, so a scene's velocities read back as given at step 0, free fall
 // reads v0 + g t, and a box at rest on the ground reads 0.
 #[test]

@@ -1,4 +1,4 @@
-//! Ball joints (issue 4): a chain that swings and comes to rest, a pendulum
+//! Ball joints: a chain that swings and comes to rest, a pendulum
 //! with the compound-pendulum period, a loaded bridge, ragdolls on a pile.
 
 use crate::common::{quat, v3, world};
@@ -110,7 +110,7 @@ fn loaded_bridge() -> Scene {
     scene
 }
 
-/// Issue 14 part 2: a user's chain, loaded bridge and ragdolls, with the
+/// A user's chain, loaded bridge and ragdolls, with the
 /// default settings and with the suggested ones, keep every joint within
 /// 5 mm after the first second (sampled every step for 5 s: the chain's
 /// swing through its lowest point, the boxes landing on the bridge, the
@@ -236,7 +236,7 @@ fn fastest_over(scene: &Scene, steps: u32) -> Option<(f32, f32)> {
     Some((fastest, widest))
 }
 
-/// Issue 16: joint error a scene starts with is closed at a bounded speed,
+/// Joint error a scene starts with is closed at a bounded speed,
 /// as overlap is (3 m/s a joint), not snapped shut in one substep, and
 /// joints that cannot all close do not throw or spin bodies. No gravity:
 /// only the joints move anything.

@@ -1,4 +1,4 @@
-//! A property test of the scene loader (issue 7, part 2): arbitrary bytes,
+//! A property test of the scene loader: arbitrary bytes,
 //! and arbitrary mutations of a valid scene (of its text and of its JSON
 //! tree), never make `Scene::from_json_str` panic. Each input either loads
 //! into a scene that passes `validate()` and survives a write/read round

@@ -1,4 +1,4 @@
-//! Snapshots (issue 7, part 6): restoring and continuing is bit-identical to
+//! Snapshots: restoring and continuing is bit-identical to
 //! a straight run, through the API and through a file; files that are not
 //! snapshots, and snapshots of other scenes, are refused.
 

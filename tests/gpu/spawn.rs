@@ -1,4 +1,4 @@
-//! Adding and removing bodies while a world runs (issue 8, part 2).
+//! Adding and removing bodies while a world runs.
 
 use crate::common::{v3, world};
 use verlet::scenes::{self, box_body};

@@ -1,4 +1,4 @@
-//! Stress (issue 7, part 7): 10 000 steps of a 5 000-body pile with chains
+//! Stress: 10 000 steps of a 5 000-body pile with chains
 //! through it: no fault and no NaN, constant GPU memory, no growth of host
 //! memory. Too slow for CI on lavapipe, so ignored; run it by hand:
 //!

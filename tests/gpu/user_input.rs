@@ -1,4 +1,4 @@
-//! User input between steps (issue 8): impulses, poses and velocities,
+//! User input between steps: impulses, poses and velocities,
 //! explosions, fixed/dynamic switching, and the errors of bad arguments.
 
 use crate::common::{quat, v3, world};
@@ -153,7 +153,7 @@ fn a_body_given_a_pose_and_velocity_continues_from_exactly_there() {
         let pos_err = (d3(s.position) - want).length();
         let want_q = Quat::from_scaled_axis(v3(om) * dt as f32) * q;
         let angle = angle_between(want_q.as_dquat(), quat(s.orientation).as_dquat());
-        // read_state reports the velocity at the step's time (issue 16 part 5)
+        // read_state reports the velocity at the step's time
         let want_v = d3(v) + d3(gravity) * dt;
         let vel_err = (d3(s.linear_velocity) - want_v).length();
         let spin_err = (d3(s.angular_velocity) - d3(om)).length();
