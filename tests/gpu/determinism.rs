@@ -12,49 +12,11 @@ const STEPS: u64 = 300;
 /// FNV-1a 64 of `read_raw`'s bytes after `STEPS` steps on lavapipe as
 /// `PINNED_ON` names it (its vector width follows the CPU, and with it the
 /// rounding). Other adapters round differently and are only reported.
-/// Re-pinned for the solve by manifold: each manifold's points are measured
-/// once per sweep for both bodies (solve_contacts, restitution_contacts)
-/// and each body sums what its manifolds ask, and the pair walk visits half
-/// the neighbour cells, which reorders the pairs, so the float sums round
-/// differently. Re-pinned again for the displacement state: the
-/// pose holds x_n - x_(n-1) and a rounding remainder instead of the previous
-/// position (different bytes hashed, and integrate, the snaps and
-/// restitution now round differently). Re-pinned for the separating-axis
-/// test in the first box's frame (the same axes and choices, other roundings).
-/// Re-pinned for the clip in the reference face's plane (the same points,
-/// other roundings) and FACE_BIAS (the second box's face is the reference
-/// face only when it beats the first's by 2.5 mm). Re-pinned for settling
-/// (solve.wgsl: old overlap deeper than 1 m/s of a substep is pushed out by
-/// moving the poses, not the velocities; the cubes land hard enough to
-/// leave such overlap). Re-pinned for the speculative margin by relative
-/// motion (pairs.wgsl's pair_margin: cubes falling side by side no longer
-/// get contacts, so fewer manifolds are summed). Re-pinned for the contact
-/// passes' rotation and inertia matrices (solve.wgsl, restitution.wgsl: the
-/// same maths, other roundings) and friction's split against ends that stay
-/// (solve.wgsl's friction_split). Re-pinned for the face clip by candidate
-/// corners (collide.wgsl: edges' entries and exits and the reference face's
-/// corners inside, always reduced; no duplicated points where a corner lies
-/// on a side, other roundings). Re-pinned for normal pushes and dynamic
-/// friction split against ends that stay (solve.wgsl's normal_split,
-/// restitution.wgsl's cut; bodies wedged between sleepers no longer shake),
-/// then by the body's shares of all its pushes (contact_lists' normal_split).
-/// Re-pinned for the cap on support (solve.wgsl's SUPPORT_SPEED: a push out
-/// of shallow old overlap becomes upward velocity only while the body rises
-/// slower than 0.2 m/s; other bits for the landing cubes). Re-pinned for
-/// the restitution pass's bounces scaled like the solve's pushes, and a
-/// body's bouncing manifolds combined so that bounces the same way count
-/// once (restitution.wgsl: a box landing flat across four sleeping boxes
-/// left at 40 m/s; the landing cubes' bounces differ). Re-pinned for the
-/// speculative margin that counts how far a body's turn moves its points,
-/// with the fixed part 1 cm instead of 2 (pairs.wgsl's pair_margin,
-/// grid.wgsl's spin_reach_of: the tumbling cubes get other contacts).
-/// Re-pinned for dynamic friction bounded on the impulse, mu times the
-/// push's through the inverse mass along the normal (restitution.wgsl: a
-/// sliding ball had 3.5 times too little; tilted cubes' contacts differ).
-/// Any change to the step's arithmetic (shaders, settings
-/// defaults, the cubes scene) moves it on purpose: check the change, then
-/// pin the value the failure prints.
-const PINNED_LAVAPIPE: u64 = 0x8495_2691_e9d7_6b2d;
+/// Any change to the step's arithmetic (shaders, settings defaults, the
+/// cubes scene) moves it on purpose: check the change, then pin the value
+/// the failure prints (git log says what moved it and why). Last moved by
+/// friction split among all of a body's manifolds.
+const PINNED_LAVAPIPE: u64 = 0x2e2c_5df2_4ed0_76ab;
 /// The adapter name and driver the hash was pinned on.
 const PINNED_ON: (&str, &str) = ("llvmpipe (LLVM 15.0.6, 256 bits)", "Mesa 22.3.6 (LLVM 15.0.6)");
 
