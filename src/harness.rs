@@ -881,13 +881,7 @@ struct PeerRun {
 impl<'a> PeerReps<'a> {
     /// None when the peer is not run (`--no-peer`, or more bodies than
     /// `--peer-max-bodies`).
-    fn new(
-        case: &'a Case,
-        scene: &'a Scene,
-        steps: u64,
-        reps: usize,
-        opts: &'a Options,
-    ) -> Result<Option<PeerReps<'a>>, Error> {
+    fn new(case: &'a Case, scene: &'a Scene, steps: u64, reps: usize, opts: &'a Options) -> Result<Option<PeerReps<'a>>, Error> {
         if opts.no_peer || opts.peer_max_bodies.is_some_and(|m| scene.bodies.len() > m) {
             return Ok(None);
         }

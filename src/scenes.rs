@@ -360,7 +360,7 @@ pub fn joint_grid(side: usize) -> Scene {
     for k in 0..side {
         for i in 0..side {
             let index = bodies.len() as i32;
-            let mut b = sphere_body(0.4, [k as f32, -(i as f32), 0.0]);
+            let mut b = sphere_body(0.4, [k as f32, 0.0 - i as f32, 0.0]);
             b.fixed = i == 0;
             bodies.push(b);
             if i > 0 {
