@@ -123,7 +123,8 @@ fn a_pyramid_of_ten_rows_stands() {
 }
 
 /// Box3D's pyramids, small, at their own settings (sleeping off, cubes
-/// touching side by side) stand for 2 s.
+/// touching side by side) stand for 2 s. Measured: no cube moved more
+/// than 3.7 mm (10 rows; 2 x 2 pyramids of 10 rows).
 #[test]
 fn box3ds_pyramids_stand_for_two_seconds() {
     for (name, count) in [("large_pyramid", 10), ("many_pyramids", 2)] {
@@ -132,7 +133,7 @@ fn box3ds_pyramids_stand_for_two_seconds() {
         w.step(120).unwrap();
         let moved = largest_move(&scene, &w.read_state().unwrap());
         eprintln!("{name} --count {count} after 2 s: largest move {moved} m");
-        assert!(moved < 0.02, "{name} --count {count}: a box moved {moved} m");
+        assert!(moved < 0.01, "{name} --count {count}: a box moved {moved} m");
     }
 }
 
