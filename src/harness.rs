@@ -24,9 +24,9 @@
 //!    number of steps by rapier3d on the CPU, timed the same way, one of
 //!    its repetitions after each of ours (a machine whose speed drifts
 //!    during a case weighs on both engines alike): rapier's parallel
-//!    pipeline in a rayon pool of `--peer-threads` threads (default: the
-//!    machine's cores, as many as a software adapter's driver uses) and in
-//!    a pool of one thread, the two taken in turns.
+//!    pipeline in a rayon pool of `--peer-threads` threads (default: as
+//!    many as lavapipe runs, `LP_NUM_THREADS` or the machine's cores) and
+//!    in a pool of one thread, the two taken in turns.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -664,10 +664,13 @@ fn peer_description(opts: &Options, settings: &verlet::Settings) -> (String, Str
     }
 }
 
-/// Threads of the peer's parallel run: `--peer-threads`, else the machine's cores.
+/// Threads of the peer's parallel run: `--peer-threads`, else as many as
+/// lavapipe runs (`LP_NUM_THREADS` when it is a positive number; its
+/// default is the machine's cores), so that both engines have the same CPU.
 #[cfg_attr(not(feature = "rapier"), allow(dead_code))]
 fn peer_threads(opts: &Options) -> usize {
-    opts.peer_threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+    let lavapipe = std::env::var("LP_NUM_THREADS").ok().and_then(|t| t.trim().parse::<usize>().ok()).filter(|&n| n > 0);
+    opts.peer_threads.or(lavapipe).unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 /// A case's result before anything is measured.

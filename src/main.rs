@@ -134,8 +134,8 @@ struct BenchArgs {
     /// rapier's num_solver_iterations (default: rapier's own, 4).
     #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     rapier_iterations: Option<usize>,
-    /// Threads of the rapier3d peer's rayon pool (default: the machine's
-    /// cores); it also runs on one thread, reported beside.
+    /// Threads of the rapier3d peer's rayon pool (default: LP_NUM_THREADS
+    /// when set above 0, else the machine's cores); it also runs on one thread, reported beside.
     #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     peer_threads: Option<usize>,
     /// Most steps the largest pile case of at most 10k bodies takes to come to

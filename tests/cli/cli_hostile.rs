@@ -635,7 +635,8 @@ fn negative_numbers_are_refused_saying_what_the_flag_takes() {
     assert_refused_quickly(
         &["run", "--builtin", "drop", "--steps", "-1"],
         &["--steps: must be a non-negative whole number, got -1"],
-    );    // a pool of no threads would run nothing
+    );
+    // a pool of no threads would run nothing
     assert_refused_quickly(&["bench", "--peer-threads", "0"], &["--peer-threads: must be at least 1"]);
 }
 
