@@ -89,7 +89,7 @@ pub struct Options {
     /// rapier's `num_solver_iterations`; `None`: rapier's default (4).
     #[cfg_attr(not(feature = "rapier"), allow(dead_code))]
     pub rapier_iterations: Option<usize>,
-    /// Threads of the peer's parallel run; `None`: the machine's cores.
+    /// Threads of the peer's parallel run; `None`: lavapipe's (`peer_threads`).
     pub peer_threads: Option<usize>,
     /// Most steps the settled pile takes (`SETTLE_STEPS` unless given; 0: not settled).
     pub settle_steps: Option<u64>,
