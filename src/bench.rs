@@ -16,7 +16,9 @@ pub const SEED: u64 = 1;
 /// The named cases: (name, built-in scene, count; `None`: the scene's
 /// default). `cubes-1m` runs at the adapter's maximum when 1M does not fit.
 /// `pile-*` are cubes dropped in four layers that land on each other and
-/// heap up three and four deep (`verlet scene pile`).
+/// heap up three and four deep (`verlet scene pile`). `large_pyramid`,
+/// `many_pyramids` and `joint_grid` are Box3D's benchmarks of those names
+/// at Box3D's sizes.
 pub const CASES: &[(&str, &str, Option<usize>)] = &[
     ("cubes-1k", "cubes", Some(1_000)),
     ("cubes-10k", "cubes", Some(10_000)),
@@ -28,6 +30,9 @@ pub const CASES: &[(&str, &str, Option<usize>)] = &[
     ("pile-1m", "pile", Some(1_000_000)),
     ("pyramid", "pyramid", Some(20)),
     ("chain", "chain", Some(21)),
+    ("large_pyramid", "large_pyramid", Some(100)),
+    ("many_pyramids", "many_pyramids", Some(14)),
+    ("joint_grid", "joint_grid", Some(100)),
 ];
 
 /// The cases `--quick` runs.
@@ -226,13 +231,15 @@ mod tests {
 
     #[test]
     fn named_cases_parse_and_build() {
-        for (name, _, count) in CASES {
+        for (name, scene, count) in CASES {
             let c = Case::parse(name).unwrap();
             assert_eq!(c.name, *name);
             if !name.ends_with("-1m") && !name.ends_with("-100k") {
-                assert_eq!(c.scene().bodies.len(), count.map_or(0, |n| if c.scene == "pyramid" { n * (n + 1) / 2 } else { n }));
+                assert_eq!(Some(c.scene().bodies.len() as u64), scenes::body_count(scene, *count), "{name}");
             }
         }
+        assert_eq!(case("many_pyramids").scene().bodies.len(), 10_780);
+        assert_eq!(case("joint_grid").scene().joints.len(), 19_800);
         let c = Case::parse("cubes:2000").unwrap();
         assert_eq!((c.name.as_str(), c.count), ("cubes-2000", Some(2000)));
         assert!(Case::parse("nope").is_err());

@@ -73,7 +73,7 @@ enum Command {
     Scene {
         /// A built-in scene (listed below).
         name: String,
-        /// Bodies, boxes, rows, links, planks or ragdolls, by scene.
+        /// Bodies, boxes, rows, links, planks, ragdolls, pyramids or balls per side, by scene.
         #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
         count: Option<usize>,
         /// Seed of the random scenes (cubes, pile); 1 if not given.
@@ -91,8 +91,9 @@ enum Command {
 struct BenchArgs {
     /// Cases, comma-separated: cubes-1k, cubes-10k, cubes-100k, cubes-1m
     /// (the adapter's maximum when 1M does not fit), pile-1k, pile-10k,
-    /// pile-100k, pile-1m (cubes heaped four deep), pyramid, chain, or
-    /// SCENE:COUNT. Default: all (with --quick: cubes-1k, cubes-10k, pyramid, chain).
+    /// pile-100k, pile-1m (cubes heaped four deep), pyramid, chain,
+    /// large_pyramid, many_pyramids, joint_grid (Box3D's benchmarks at its
+    /// sizes), or SCENE:COUNT. Default: all (with --quick: cubes-1k, cubes-10k, pyramid, chain).
     #[arg(long, value_delimiter = ',')]
     cases: Vec<String>,
     /// Steps per repetition (default 300; 60 with --quick).
@@ -133,6 +134,10 @@ struct BenchArgs {
     /// rapier's num_solver_iterations (default: rapier's own, 4).
     #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     rapier_iterations: Option<usize>,
+    /// Threads of the rapier3d peer's rayon pool (default: LP_NUM_THREADS
+    /// when set above 0, else the machine's cores); it also runs on one thread, reported beside.
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
+    peer_threads: Option<usize>,
     /// Most steps the largest pile case of at most 10k bodies takes to come to
     /// rest, with sleeping on, for the memory of a settled pile (default 1800
     /// with --settle; given alone, it asks for --settle; 0: not settled).
@@ -314,6 +319,7 @@ fn bench(a: BenchArgs) -> Result<(), verlet::Error> {
             dispatch_cost: a.dispatch_cost || a.all,
         },
         rapier_iterations: a.rapier_iterations,
+        peer_threads: a.peer_threads,
         command: std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect::<Vec<_>>().join(" "),
     })?;
     if let Some(path) = &a.plot {

@@ -623,6 +623,7 @@ fn negative_numbers_are_refused_saying_what_the_flag_takes() {
         ("--seed", vec!["scene", "cubes", "--seed", "-1"]),
         ("--reps", vec!["bench", "--reps", "-1"]),
         ("--steps", vec!["bench", "--steps", "-3"]),
+        ("--peer-threads", vec!["bench", "--peer-threads", "-2"]),
     ] {
         let (out, took) = capped(&args);
         assert_refused(&args, &out, &[flag, "-"]);
@@ -635,6 +636,8 @@ fn negative_numbers_are_refused_saying_what_the_flag_takes() {
         &["run", "--builtin", "drop", "--steps", "-1"],
         &["--steps: must be a non-negative whole number, got -1"],
     );
+    // a pool of no threads would run nothing
+    assert_refused_quickly(&["bench", "--peer-threads", "0"], &["--peer-threads: must be at least 1"]);
 }
 
 #[test]

@@ -11,3 +11,4 @@ mod cli_frames;
 mod cli_hostile;
 mod cli_info;
 mod cli_run;
+mod cli_scene;

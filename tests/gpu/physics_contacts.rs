@@ -122,6 +122,21 @@ fn a_pyramid_of_ten_rows_stands() {
     assert!(moved < 0.05, "a box moved {moved} m");
 }
 
+/// Box3D's pyramids, small, at their own settings (sleeping off, cubes
+/// touching side by side) stand for 2 s. Measured: no cube moved more
+/// than 3.7 mm (10 rows; 2 x 2 pyramids of 10 rows).
+#[test]
+fn box3ds_pyramids_stand_for_two_seconds() {
+    for (name, count) in [("large_pyramid", 10), ("many_pyramids", 2)] {
+        let scene = scenes::by_name(name, Some(count), 1).unwrap();
+        let Some(mut w) = world(&scene) else { return };
+        w.step(120).unwrap();
+        let moved = largest_move(&scene, &w.read_state().unwrap());
+        eprintln!("{name} --count {count} after 2 s: largest move {moved} m");
+        assert!(moved < 0.01, "{name} --count {count}: a box moved {moved} m");
+    }
+}
+
 /// A box wedged between fixed boxes, four under it and four pressing on it
 /// from above (1 mm), sent sideways at 0.3 m/s: friction stops it and it
 /// stays. Each of the eight manifolds undid its whole slide and the solve

@@ -223,6 +223,22 @@ fn a_chain_hung_by_both_ends_settles_into_a_catenary() {
     }
 }
 
+/// Box3D's joint grid, 10 x 10 balls hung by the top row, holds together
+/// and hangs where it started (it starts at rest, every joint closed).
+/// Measured: the widest gap 0.05 mm, the bottom row 0.2 mm lower.
+#[test]
+fn box3ds_joint_grid_of_ten_by_ten_holds_together() {
+    let scene = scenes::joint_grid(10);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(120).unwrap();
+    let state = w.read_state().unwrap();
+    let widest = joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max);
+    let lowest = state.iter().map(|b| b.position[1]).fold(f32::MAX, f32::min);
+    eprintln!("joint_grid 10 x 10 after 2 s: widest joint gap {:.2} mm, lowest ball at y = {lowest} m", widest * 1e3);
+    assert!(widest < 0.001, "a joint opened {widest} m");
+    assert!(lowest > -9.01, "the grid sagged: its lowest ball is at y = {lowest} m, placed at -9");
+}
+
 /// The fastest body over `steps` steps (m/s), and the widest joint gap at the end.
 fn fastest_over(scene: &Scene, steps: u32) -> Option<(f32, f32)> {
     let mut w = world(scene)?;
