@@ -99,8 +99,12 @@ struct Params {
     sleep_after: f32,        // seconds at rest before a body sleeps; 0: never (settings.sleeping)
     substep: u32,            // which substep of the step this is (0 first)
     opaque_zero: u32,        // always 0; see `opaque` (integrate.wgsl)
-    island_count: u32,       // joint islands (solve_joints)
-    joint_sweeps: u32,       // sweeps over each island per solve_joints pass
+    island_count: u32,       // joint islands (joint_rest)
+    joint_sweeps: u32,       // the most sweeps along a path per solve_joints pass
+    path_first: u32,         // the paths of this solve_joints pass's colour:
+    path_end: u32,           //   path_first..path_end (joint_lists)
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // A candidate pair found by the broadphase (pairs.wgsl): body a owns it; b

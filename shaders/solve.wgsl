@@ -352,21 +352,23 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     set_state(i, s);
 }
 
-// Pass "solve_joints", after every solve: ball joints closed one after the
-// other, in place on the poses solve just wrote, one invocation per joint
-// island (see joint_lists in src/world/records.rs: an island's bodies are
-// its own, no other invocation reads or writes them, and its joints come in
-// a fixed order, so the result never depends on thread timing). Jacobi
-// carries a correction one link per sweep: a user's chain of 21 links
-// opened 2.1 cm (3 iterations) and 8 mm (8 iterations), ragdolls wedged
-// on a pile 7 cm. In turn, a sweep outward from where the island is held
-// and back carries it along the whole island. Each joint's snap closes its
-// whole gap (eq. 9 with nothing to overshoot: no other snap is summed with
-// it; only an old gap's closing speed is bounded, see close_joint), shared
-// by the two bodies' generalised inverse masses along the gap,
-// and moves the displacement with the pose, as solve's snaps do. A pass
-// makes params.joint_sweeps such sweeps (see JOINT_SWEEPS_PER_SUBSTEP in
-// src/world.rs).
+// Pass "solve_joints", after every solve, once per colour of the joint
+// paths (see joint_lists in src/world/records.rs): ball joints closed one
+// after the other along each path, in place on the poses solve just wrote,
+// one invocation per path of the colour. No two paths of a colour share a
+// body that moves, and a path's joints come in a fixed order, so the result
+// never depends on thread timing. Jacobi carries a correction one link per
+// sweep: a user's chain of 21 links opened 2.1 cm (3 sweeps) and 8 mm (8),
+// ragdolls wedged on a pile 7 cm. In turn, a sweep outward along a path
+// and back carries it along the whole path, and the colours one after the
+// other carry it between paths. Each joint's snap closes its whole gap
+// (eq. 9 with nothing to overshoot: no other snap is summed with it; only
+// an old gap's closing speed is bounded, see close_joint), shared by the
+// two bodies' generalised inverse masses along the gap, and moves the
+// displacement with the pose, as solve's snaps do. A pass makes up to
+// params.joint_sweeps such sweeps along each path (see
+// JOINT_SWEEPS_PER_SUBSTEP in src/world.rs), fewer along a long one
+// (SHORT_PATH).
 
 // Close one joint: body j.body and its partner (or the world) move along
 // the gap between the two anchors until they meet, or until it has closed
@@ -417,11 +419,25 @@ fn close_joint(j: JointRef) {
     }
 }
 
-// An island of n joints takes 2n loop trips to read and set its rest times
-// and 2n a sweep, within LOOP_TRIPS (bindings.wgsl); World::with_gpu
-// refuses one with no room for a sweep.
+// A path of up to SHORT_PATH joints (a chain, a bridge, a ragdoll) makes
+// the pass's joint_sweeps; a longer one (a row of a large island cut into
+// paths) min(joint_sweeps, PATH_CLOSES / 2n), at least one: a column of 100
+// joints of Box3D's grid makes 5, which the colours' turns make up for
+// (the grid of 100 x 100 opened 8 mm in 5 s at the defaults; 24 mm with a
+// quarter of PATH_CLOSES, at a quarter of the cost).
+const SHORT_PATH: u32 = 64u;
+const PATH_CLOSES: u32 = 1024u;
+
+// Pass "joint_rest", once a substep after its first solve, in place: an
+// island sleeps and wakes as one. Every body of it takes the least rest
+// time of them all (so none sleeps before the last comes to rest, and
+// waking one wakes all), or none if nothing holds the island up (no body
+// of it pressed by a contact, no joint to the world or a fixed body: it
+// flies free). One invocation per island; an island of n joints takes 2n
+// loop trips, within LOOP_TRIPS (bindings.wgsl); World::with_gpu refuses
+// a larger one.
 @compute @workgroup_size(WORKGROUP)
-fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn joint_rest(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.island_count) {
         return;
     }
@@ -429,11 +445,6 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     let at = params.body_count + 1u + gid.x;
     let first = joint_start[at];
     let end = joint_start[at + 1u];
-    // An island sleeps and wakes as one: every body of it takes the least
-    // rest time of them all (so none sleeps before the last comes to rest,
-    // and waking one wakes all), or none if nothing holds the island up (no
-    // body of it pressed by a contact, no joint to the world or a fixed
-    // body: it flies free). Asleep, the island is left as it is.
     var rest = 3.4e38;
     var held = false;
     for (var e = first; e < end; e = e + 1u) {
@@ -450,9 +461,6 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     rest = select(0.0, rest, held);
-    if (params.sleep_after > 0.0 && rest >= params.sleep_after) {
-        return;
-    }
     for (var e = first; e < end; e = e + 1u) {
         set_rest_time(joint_refs[e].body, rest);
         let partner = joint_refs[e].partner;
@@ -460,13 +468,28 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
             set_rest_time(partner, rest);
         }
     }
-    // params.joint_sweeps times forward then back, as one loop whose trip
-    // count is the island's own (a loop bounded by a uniform alone makes
-    // lavapipe compile the kernel again for every dispatch); where the
-    // driver ends an invocation's loops past LOOP_TRIPS trips, as many
-    // whole sweeps as fit beside the two loops above
+}
+
+@compute @workgroup_size(WORKGROUP)
+fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let path = params.path_first + gid.x;
+    if (path >= params.path_end) {
+        return;
+    }
+    // path p's joints follow the islands' in joint_start
+    let at = params.body_count + params.island_count + 2u + path;
+    let first = joint_start[at];
+    let end = joint_start[at + 1u];
+    // asleep, the island is left as it is (joint_rest gave every body of
+    // it the island's rest time)
+    if (params.sleep_after > 0.0 && out_state(joint_refs[first].body).rest_time >= params.sleep_after) {
+        return;
+    }
+    // the sweeps forward then back, as one loop whose trip count is the
+    // path's own (a loop bounded by a uniform alone makes lavapipe compile
+    // the kernel again for every dispatch)
     let n = end - first;
-    let sweeps = min(params.joint_sweeps, max(LOOP_TRIPS / max(2u * n, 1u), 2u) - 1u);
+    let sweeps = select(max(min(params.joint_sweeps, PATH_CLOSES / (2u * n)), 1u), params.joint_sweeps, n <= SHORT_PATH);
     for (var t = 0u; t < 2u * n * sweeps; t = t + 1u) {
         let r = t % (2u * n);
         close_joint(joint_refs[select(first + r, end - 1u - (r - n), r >= n)]);

@@ -418,8 +418,12 @@ pub struct World {
     grid: GridLayout,
     large_count: u32,
     body_count: u32,
-    /// Joint islands (`solve_joints` runs only when there are any).
+    /// Joint islands (`joint_rest` and `solve_joints` run only when there
+    /// are any).
     island_count: u32,
+    /// Where each colour of the joint paths begins, and after the last its
+    /// end (`JointLists::colours`): `solve_joints` runs once per colour.
+    path_colours: Vec<u32>,
     /// Whether the bodies' speed limits (`BodyProps::speed_limit`, from the
     /// scene's energy) still hold: no input, edit or restore since.
     speed_limits: bool,
@@ -510,7 +514,7 @@ impl World {
         let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&joints.refs));
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
-            size: PARAMS_STRIDE * MAX_BATCH as u64,
+            size: PARAMS_STRIDE * MAX_BATCH.max(settings.substeps as usize * (1 + joints.colour_count() as usize)) as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -553,6 +557,7 @@ impl World {
             large_count: large.len() as u32,
             body_count: n as u32,
             island_count: joints.islands,
+            path_colours: joints.colours.clone(),
             speed_limits: true,
             current: 0,
             step: 0,
@@ -604,7 +609,7 @@ impl World {
                 // its batches had been counted one by one)
                 return self.skip_at_rest(left, dt);
             }
-            let batch = left.min((MAX_BATCH / self.settings.substeps as usize).max(1) as u64);
+            let batch = left.min(self.steps_per_batch() as u64);
             let dts = vec![dt; batch as usize];
             self.step_with(&dts)?;
             left -= batch;
@@ -627,8 +632,7 @@ impl World {
             }
         }
         let substeps = self.settings.substeps as usize;
-        let per_batch = (MAX_BATCH / substeps).max(1);
-        for chunk in dts.chunks(per_batch) {
+        for chunk in dts.chunks(self.steps_per_batch()) {
             if self.at_rest {
                 // what the skipped steps would have listed: nothing moves,
                 // so no pair and no manifold (the pools follow)
@@ -813,11 +817,24 @@ impl World {
         (size(&self.data.pairs, std::mem::size_of::<Pair>()), size(&self.data.manifolds, std::mem::size_of::<ContactManifold>()))
     }
 
-    /// Writes one Params slot per substep of `dts`.
+    /// The Params slots a substep takes: its own, then one per colour of
+    /// the joint paths (`solve_joints` reads its colour's paths from it).
+    fn slots_per_substep(&self) -> usize {
+        self.path_colours.len().max(1)
+    }
+
+    /// The steps a batch holds: as many as the Params buffer has slots for
+    /// (`MAX_BATCH`), at least one (the buffer holds one step's).
+    fn steps_per_batch(&self) -> usize {
+        (MAX_BATCH / (self.settings.substeps as usize * self.slots_per_substep())).max(1)
+    }
+
+    /// Writes the Params slots of every substep of `dts` (`slots_per_substep`
+    /// each) and returns how many.
     fn write_params(&mut self, dts: &[f32], substeps: usize) -> usize {
         let s = &self.settings;
-        // one Params slot per substep of the batch
-        let mut slots = vec![0u8; PARAMS_STRIDE as usize * dts.len() * substeps];
+        let slots_each = self.slots_per_substep();
+        let mut slots = vec![0u8; PARAMS_STRIDE as usize * dts.len() * substeps * slots_each];
         let mut dt_prev = self.dt_prev;
         let mut slot = 0;
         for (k, &dt) in dts.iter().enumerate() {
@@ -849,11 +866,16 @@ impl World {
                     opaque_zero: 0,
                     island_count: self.island_count,
                     joint_sweeps: JOINT_SWEEPS_PER_SUBSTEP.div_ceil(s.sweeps(substep as u32)),
+                    ..Params::default()
                 };
-                let at = slot * PARAMS_STRIDE as usize;
-                slots[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
+                // the substep's own, then one per colour of the joint paths
+                let colours = self.path_colours.windows(2).map(|w| (w[0], w[1]));
+                for p in std::iter::once(p).chain(colours.map(|(first, end)| Params { path_first: first, path_end: end, ..p })) {
+                    let at = slot * PARAMS_STRIDE as usize;
+                    slots[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
+                    slot += 1;
+                }
                 dt_prev = h;
-                slot += 1;
             }
         }
         self.gpu.queue.write_buffer(&self.data.params, 0, &slots);
@@ -892,7 +914,7 @@ impl World {
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("step") });
         self.copy_batch_start(&mut encoder);
         let plan = self.step_plan();
-        for first in (0..slot).step_by(substeps) {
+        for first in (0..slot).step_by(substeps * self.slots_per_substep()) {
             self.encode_step(&mut encoder, &plan, first);
         }
         self.gpu.queue.submit([encoder.finish()]);
@@ -959,7 +981,8 @@ impl World {
         }
     }
 
-    /// The passes of one step, each with the substep whose Params it uses:
+    /// The passes of one step, each with the Params slot it uses within the
+    /// step (`slots_per_substep` a substep; `solve_joints` one per colour):
     /// the broadphase and narrowphase once, then for every substep the
     /// integration, its share of the `iterations` sweeps of the solve's two
     /// halves (`Settings::sweeps`) and the
@@ -978,18 +1001,24 @@ impl World {
         };
         let mut plan: Vec<(Stage, usize)> =
             Stage::ALL.iter().take_while(|s| **s != Stage::Integrate).filter(|s| needed(s)).map(|&s| (s, 0)).collect();
+        let per_substep = self.slots_per_substep();
         for sub in 0..self.settings.substeps as usize {
-            plan.push((Stage::Integrate, sub));
-            for _ in 0..self.settings.sweeps(sub as u32) {
-                plan.extend([(Stage::SolveContacts, sub), (Stage::Solve, sub)]);
+            let at = sub * per_substep;
+            plan.push((Stage::Integrate, at));
+            for sweep in 0..self.settings.sweeps(sub as u32) {
+                plan.extend([(Stage::SolveContacts, at), (Stage::Solve, at)]);
                 if self.island_count > 0 {
-                    plan.push((Stage::SolveJoints, sub));
+                    // islands sleep as one only where bodies sleep at all
+                    if sweep == 0 && self.settings.sleeping {
+                        plan.push((Stage::JointRest, at));
+                    }
+                    plan.extend((1..per_substep).map(|c| (Stage::SolveJoints, at + c)));
                 }
             }
-            plan.push((Stage::RestitutionContacts, sub));
+            plan.push((Stage::RestitutionContacts, at));
             // the next substep's integrate applies what it asks (integrate.wgsl)
             if sub + 1 == self.settings.substeps as usize {
-                plan.push((Stage::Restitution, sub));
+                plan.push((Stage::Restitution, at));
             }
         }
         plan
@@ -1126,6 +1155,7 @@ impl World {
             Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_SPAN),
             Over::One => 1,
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
+            Over::Paths => self.path_colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0).div_ceil(WORKGROUP),
             Over::Pairs | Over::Manifolds | Over::Listed => unreachable!("dispatched indirectly"),
         };
         n.max(1)
@@ -1324,18 +1354,19 @@ fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
     Ok(())
 }
 
-/// Whether `solve_joints` can sweep every joint island at least once: one
-/// invocation closes an island's joints in turn, and where the driver ends
-/// an invocation's loops past `Gpu::loop_trips` (lavapipe), an island of n
-/// joints takes 2n trips for its rest times and 2n a sweep.
+/// Whether `joint_rest` can keep every joint island's rest time: one
+/// invocation reads and writes an island's, and where the driver ends an
+/// invocation's loops past `Gpu::loop_trips` (lavapipe), an island of n
+/// joints takes 2n trips. (The sweeps go along paths of at most
+/// `PATH_JOINTS` joints, which any island is cut into.)
 fn check_islands(gpu: &Gpu, joints: &JointLists, bodies: usize) -> Result<(), Error> {
     let (Some(trips), largest) = (gpu.loop_trips(), joints.largest_island(bodies)) else { return Ok(()) };
-    let most = trips / 4;
+    let most = trips / 2;
     if largest > most {
         return Err(Error::Capacity(format!(
             "joints: an island of {largest} joints (bodies joined to each other, directly or through others) is more \
-             than this adapter can close: one invocation sweeps an island's joints in turn, and {} ends an \
-             invocation's loops after 65535 trips, room for islands of at most {most} joints",
+             than this adapter can keep asleep or awake as one: one invocation reads an island's rest times, and {} \
+             ends an invocation's loops after 65535 trips, room for islands of at most {most} joints",
             gpu.info.name
         )));
     }

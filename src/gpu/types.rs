@@ -114,10 +114,16 @@ pub struct Params {
     /// bits with it so that the driver cannot fold TwoSum's `(a + b) - a`
     /// back to `b` (Mesa's optimiser does, for operations not marked exact).
     pub opaque_zero: u32,
-    /// Joint islands `solve_joints` sweeps (see `joint_lists`).
+    /// Joint islands `joint_rest` keeps asleep or awake as one (see
+    /// `joint_lists`).
     pub island_count: u32,
-    /// Gauss-Seidel sweeps over every joint island per `solve_joints` pass.
+    /// The most Gauss-Seidel sweeps along a path per `solve_joints` pass.
     pub joint_sweeps: u32,
+    /// The paths of this `solve_joints` pass's colour: `path_first..path_end`.
+    pub path_first: u32,
+    pub path_end: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
 }
 
 /// A candidate pair (8 bytes); see `Pair` in common.wgsl.

@@ -8,9 +8,10 @@
 //!    clips the face contacts, over the top run of the pool
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl), after
 //!    applying the last substep's restitution in a step's later substeps
-//! 5. `solve_contacts`, `solve`, `solve_joints` — the substep's share of the `iterations` sweeps of corrective snaps:
-//!    per manifold what it asks of its bodies, then per body the sum (Jacobi), then per
-//!    joint island its joints in turn (Gauss-Seidel; only in scenes with joints)
+//! 5. `solve_contacts`, `solve`, `joint_rest`, `solve_joints` — the substep's share of the
+//!    `iterations` sweeps of corrective snaps: per manifold what it asks of its bodies, then
+//!    per body the sum (Jacobi), then (only in scenes with joints; `joint_rest` once a
+//!    substep) per colour of joint paths each path's joints in turn (Gauss-Seidel)
 //!    (shaders/solve.wgsl)
 //! 6. `restitution_contacts`, `restitution` — bounce and dynamic friction, by
 //!    rewriting the previous pose, in the same two halves (shaders/restitution.wgsl);
@@ -46,6 +47,7 @@ pub enum Stage {
     Integrate,
     SolveContacts,
     Solve,
+    JointRest,
     SolveJoints,
     RestitutionContacts,
     Restitution,
@@ -70,6 +72,9 @@ pub enum Over {
     Manifolds,
     /// The joint islands (see `joint_lists`).
     Islands,
+    /// The joint paths of one colour (see `joint_lists`): the widest
+    /// colour's count, each dispatch bounded by its Params.
+    Paths,
     /// The bodies the step may change (`listed_body` in bindings.wgsl): an
     /// indirect dispatch whose size `contact_lists` counted (status[17..20],
     /// copied to `dispatch` + 32 after it).
@@ -146,7 +151,7 @@ impl Buffer {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 20] = [
+    pub const ALL: [Stage; 21] = [
         Stage::GridCount,
         Stage::GridScanBlocks,
         Stage::GridScanSums,
@@ -164,6 +169,7 @@ impl Stage {
         Stage::Integrate,
         Stage::SolveContacts,
         Stage::Solve,
+        Stage::JointRest,
         Stage::SolveJoints,
         Stage::RestitutionContacts,
         Stage::Restitution,
@@ -190,6 +196,7 @@ impl Stage {
             Stage::Integrate => "integrate",
             Stage::SolveContacts => "solve_contacts",
             Stage::Solve => "solve",
+            Stage::JointRest => "joint_rest",
             Stage::SolveJoints => "solve_joints",
             Stage::RestitutionContacts => "restitution_contacts",
             Stage::Restitution => "restitution",
@@ -216,7 +223,7 @@ impl Stage {
                 shaders::NARROWPHASE_PASS
             }
             Stage::Integrate => shaders::INTEGRATE_PASS,
-            Stage::SolveContacts | Stage::Solve | Stage::SolveJoints => shaders::SOLVE_PASS,
+            Stage::SolveContacts | Stage::Solve | Stage::JointRest | Stage::SolveJoints => shaders::SOLVE_PASS,
             Stage::RestitutionContacts | Stage::Restitution => shaders::RESTITUTION_PASS,
             _ => shaders::GRID_PASS,
         }
@@ -258,7 +265,7 @@ impl Stage {
                 &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3]
             }
             Stage::Solve => &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1],
-            Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
+            Stage::JointRest | Stage::SolveJoints => &[Params, Props, StateOut, JointStart, JointRefs],
             Stage::RestitutionContacts => {
                 &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3]
             }
@@ -285,7 +292,7 @@ impl Stage {
             Stage::NarrowphaseClip => &[Manifolds, PairMeta, Points, Points1, Points2, Points3],
             Stage::Integrate => &[StateOut, Vel0, Status, PairMeta],
             Stage::SolveContacts | Stage::RestitutionContacts => &[Snaps, Points, Points1, Points2, Points3, Snaps1],
-            Stage::Solve | Stage::SolveJoints | Stage::Restitution => &[StateOut],
+            Stage::Solve | Stage::JointRest | Stage::SolveJoints | Stage::Restitution => &[StateOut],
         }
     }
 
@@ -308,7 +315,7 @@ impl Stage {
         match self {
             s if s.is_broadphase() => Part::Broadphase,
             Stage::Integrate => Part::Integrate,
-            Stage::SolveContacts | Stage::Solve | Stage::SolveJoints => Part::Solve,
+            Stage::SolveContacts | Stage::Solve | Stage::JointRest | Stage::SolveJoints => Part::Solve,
             Stage::RestitutionContacts | Stage::Restitution => Part::Restitution,
             _ => Part::Narrowphase,
         }
@@ -324,7 +331,7 @@ impl Stage {
     /// through the bind group whose state_out is the current state (the one
     /// the pass before it wrote), and nothing flips.
     pub fn edits_in_place(self) -> bool {
-        self == Stage::SolveJoints
+        matches!(self, Stage::JointRest | Stage::SolveJoints)
     }
 
     /// Whether the pass writes state_out (so the current state flips).
@@ -340,7 +347,8 @@ impl Stage {
             Stage::PairsScanBlocks => Over::BodyScanBlocks,
             Stage::Narrowphase => Over::Pairs,
             Stage::NarrowphaseClip | Stage::SolveContacts | Stage::RestitutionContacts => Over::Manifolds,
-            Stage::SolveJoints => Over::Islands,
+            Stage::JointRest => Over::Islands,
+            Stage::SolveJoints => Over::Paths,
             Stage::Integrate | Stage::Solve | Stage::Restitution => Over::Listed,
             _ => Over::Bodies,
         }

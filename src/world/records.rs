@@ -94,26 +94,57 @@ pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> B
 ///   `refs[starts[i]..starts[i + 1]]`, in the order the joints are listed
 ///   (the pair pass skips jointed pairs; integrate counts a jointed body
 ///   as held up when it decides whether it rests).
-/// - After them, the joint islands `solve_joints` sweeps: island k's joints
-///   are `refs[starts[n + 1 + k]..starts[n + 2 + k]]` (n bodies), each once,
-///   seen from its `body` end. An island is a set of movable bodies joined
-///   to each other (fixed bodies and the world join nothing: a joint to one
-///   belongs to its movable body's island), its joints ordered outward from
-///   where it is held (breadth first from the bodies joined to the world or
-///   a fixed body, else from its lowest body), so a forward sweep carries a
-///   correction from the anchor to the free ends and a backward one back.
-///   Joints between two fixed bodies are left out: nothing can move them.
+/// - After them, the joint islands, for `joint_rest` (an island sleeps and
+///   wakes as one): island k's joints are
+///   `refs[starts[n + 1 + k]..starts[n + 2 + k]]` (n bodies), each once,
+///   seen from its `body` end. An island
+///   is a set of movable bodies joined to each other (fixed bodies and the
+///   world join nothing: a joint to one belongs to its movable body's
+///   island), its joints ordered outward from where it is held (breadth
+///   first from the bodies joined to the world or a fixed body, else from
+///   its lowest body). Joints between two fixed bodies are left out:
+///   nothing can move them.
+/// - After the islands, the paths `solve_joints` sweeps (path p's joints
+///   are `refs[starts[n + islands + 2 + p]..]`): every joint once, an
+///   island of at most `PATH_JOINTS` joints as one path in its order (a
+///   chain, a bridge, a ragdoll), a larger one cut into runs of at most
+///   `PATH_JOINTS` joints that go on through a shared body as nearly
+///   straight as they can, from where the island is held (a hanging grid's
+///   columns, then its rows), each joint seen from the end it shares with
+///   the one before it, so a forward sweep carries a correction along the
+///   path and a backward one back. They come by colour: no two
+///   paths of one colour share a movable body, so `solve_joints` sweeps a
+///   colour's paths side by side, one invocation each, and the colours one
+///   after the other (Gauss-Seidel along a path and between colours).
 pub struct JointLists {
     pub starts: Vec<u32>,
     pub refs: Vec<JointRef>,
     pub islands: u32,
+    /// Where each colour's paths begin, and after the last its end: colour
+    /// c holds paths `colours[c]..colours[c + 1]`.
+    pub colours: Vec<u32>,
 }
+
+/// The most joints of one path: an invocation sweeps it forward and back,
+/// within the driver's loop limit with room to spare (`solve_joints`), and
+/// long enough that a chain or a row of a grid is one path.
+pub const PATH_JOINTS: usize = 128;
 
 impl JointLists {
     /// The most joints one island holds (0 without joints), of a scene of
     /// `bodies` bodies.
     pub fn largest_island(&self, bodies: usize) -> u32 {
-        self.starts[bodies + 1..].windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0)
+        self.starts[bodies + 1..bodies + 2 + self.islands as usize].windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0)
+    }
+
+    /// The paths' colours: `solve_joints` is dispatched once per colour.
+    pub fn colour_count(&self) -> u32 {
+        self.colours.len().saturating_sub(1) as u32
+    }
+
+    /// The most paths one colour holds.
+    pub fn widest_colour(&self) -> u32 {
+        self.colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0)
     }
 }
 
@@ -164,6 +195,8 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
     let mut islands = 0u32;
     let mut queue = std::collections::VecDeque::new();
     let mut island_starts = Vec::new();
+    // the islands' joints in order, each with the body it is seen from
+    let mut island_order: Vec<Vec<(usize, u32)>> = Vec::new();
     // reached by an island's walk (each body belongs to one island)
     let mut reached = vec![false; n];
     for seed in seeds {
@@ -172,6 +205,7 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
         }
         // this seed's island: every root in it starts the breadth-first walk
         island_starts.push(refs.len() as u32);
+        island_order.push(Vec::new());
         let mut members = vec![seed];
         placed[seed] = true;
         let mut at = 0;
@@ -203,6 +237,7 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
                 let j = &scene.joints[k];
                 let me = if j.bodies[0] == b as i32 { 0 } else { 1 };
                 refs.push(end(j, me));
+                island_order.last_mut().expect("the island begun above").push((k, b as u32));
                 let other = j.bodies[1 - me];
                 if movable(other) && !reached[other as usize] {
                     reached[other as usize] = true;
@@ -214,7 +249,130 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
     }
     island_starts.push(refs.len() as u32);
     starts.extend(island_starts);
-    JointLists { starts, refs, islands }
+    let (paths, colours) = joint_paths(scene, &island_order, &touching);
+    for path in paths {
+        starts.push(refs.len() as u32);
+        refs.extend(path);
+    }
+    starts.push(refs.len() as u32);
+    JointLists { starts, refs, islands, colours }
+}
+
+/// The joints cut into coloured paths (see `JointLists`), from the islands'
+/// joints in their order (each joint with the body it is seen from);
+/// `touching`: the joints each movable body takes part in. Returns
+/// the paths in colour order and where each colour begins.
+fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usize>]) -> (Vec<Vec<JointRef>>, Vec<u32>) {
+    let movable = |b: u32| b != WORLD && !scene.bodies[b as usize].fixed;
+    let end_at = |k: usize, at: u32| -> JointRef {
+        let j = &scene.joints[k];
+        let me = usize::from(j.bodies[0] != at as i32);
+        let other = j.bodies[1 - me];
+        JointRef {
+            local_self: j.anchors[me],
+            partner: if other < 0 { WORLD } else { other as u32 },
+            local_partner: j.anchors[1 - me],
+            body: at,
+        }
+    };
+    let mut taken = vec![false; scene.joints.len()];
+    // the joint at body `at` (a movable one) not yet taken that goes on most
+    // nearly straight from `from` (where, in its frame, the path came in;
+    // the first listed among equals), taken, seen from `at`
+    let straightest = |at: u32, from: [f32; 3], taken: &mut Vec<bool>| -> Option<(usize, JointRef)> {
+        if !movable(at) {
+            return None;
+        }
+        let came = -glam::Vec3::from(from).normalize_or_zero();
+        let straight = |r: &JointRef| glam::Vec3::from(r.local_self).normalize_or_zero().dot(came);
+        let mut best: Option<(usize, JointRef)> = None;
+        // a turn of a right angle or more ends the path: a grid's columns
+        // and rows stay apart, so that two colours hold them
+        let ahead = touching[at as usize].iter().filter(|&&k| !taken[k]).map(|&k| (k, end_at(k, at)));
+        for (k, r) in ahead.filter(|(_, r)| straight(r) > 0.0 || came == glam::Vec3::ZERO) {
+            if best.as_ref().is_none_or(|(_, b)| straight(&r) > straight(b)) {
+                best = Some((k, r));
+            }
+        }
+        let (k, r) = best?;
+        taken[k] = true;
+        Some((k, r))
+    };
+    let mut paths: Vec<(Vec<JointRef>, Vec<u32>)> = Vec::new();
+    // paths start where the islands are held (a joint to the world or a
+    // fixed body), so that one sweeps outward from its anchor
+    // an island of at most PATH_JOINTS joints is one path, in its order
+    // (outward from where it is held): a chain, a bridge or a ragdoll is
+    // swept whole, its parallel joints (a bridge's two ropes) together
+    for island in islands.iter().filter(|i| i.len() <= PATH_JOINTS) {
+        let path: Vec<JointRef> = island.iter().map(|&(k, at)| end_at(k, at)).collect();
+        let bodies = path.iter().flat_map(|r| [r.body, r.partner]).filter(|&b| movable(b)).collect();
+        island.iter().for_each(|&(k, _)| taken[k] = true);
+        paths.push((path, bodies));
+    }
+    // a larger one is cut into paths that start where it is held
+    let order: Vec<(usize, u32)> = islands.iter().filter(|i| i.len() > PATH_JOINTS).flatten().copied().collect();
+    let anchored = order.iter().filter(|&&(k, at)| !movable(end_at(k, at).partner));
+    for &(k, at) in anchored.chain(&order) {
+        if taken[k] {
+            continue;
+        }
+        taken[k] = true;
+        let r = end_at(k, at);
+        let mut path = vec![r];
+        let mut bodies: Vec<u32> = [r.body, r.partner].into_iter().filter(|&b| movable(b)).collect();
+        // on from the far end (from the body where the far end is the world
+        // or a fixed body), through joints not yet taken, each time the one
+        // that goes on most nearly straight (a hanging grid's columns and
+        // rows each become paths); `from`: where, in the end body's frame,
+        // the path came in
+        let anchored = !movable(r.partner);
+        let (mut end, mut from) = if anchored { (r.body, r.local_self) } else { (r.partner, r.local_partner) };
+        while path.len() < PATH_JOINTS {
+            let Some((_, e)) = straightest(end, from, &mut taken) else { break };
+            path.push(e);
+            (end, from) = (e.partner, e.local_partner);
+            bodies.extend([end].into_iter().filter(|&b| movable(b)));
+        }
+        // and back from its start, where it does not start at an anchor (a
+        // row found in its middle is one path, not two)
+        let (mut start, mut from) = (r.body, r.local_self);
+        while !anchored && path.len() < PATH_JOINTS {
+            let Some((k, e)) = straightest(start, from, &mut taken) else { break };
+            // seen from the far end, so that the path reads on into its start
+            path.insert(0, end_at(k, e.partner));
+            (start, from) = (e.partner, e.local_partner);
+            bodies.extend([start].into_iter().filter(|&b| movable(b)));
+        }
+        paths.push((path, bodies));
+    }
+    // greedy colours in path order: the first colour none of the path's
+    // bodies has been given yet
+    let mut used: Vec<Vec<u32>> = vec![Vec::new(); scene.bodies.len()];
+    let mut colour_of = Vec::with_capacity(paths.len());
+    for (_, bodies) in &paths {
+        let c = (0u32..).find(|c| bodies.iter().all(|&b| !used[b as usize].contains(c))).expect("a free colour");
+        for &b in bodies {
+            used[b as usize].push(c);
+        }
+        colour_of.push(c);
+    }
+    let count = colour_of.iter().max().map_or(0, |&c| c + 1);
+    let mut colours = vec![0u32];
+    let mut ordered = Vec::with_capacity(paths.len());
+    let mut paths: Vec<Option<Vec<JointRef>>> = paths.into_iter().map(|(p, _)| Some(p)).collect();
+    for c in 0..count {
+        for (p, &pc) in colour_of.iter().enumerate() {
+            if pc == c {
+                ordered.push(paths[p].take().expect("each path once"));
+            }
+        }
+        colours.push(ordered.len() as u32);
+    }
+    if count == 0 {
+        colours.clear();
+    }
+    (ordered, colours)
 }
 
 /// How far each joint has opened (m): the distance between its two anchors.
@@ -386,6 +544,64 @@ mod tests {
         // 4); a body's joints in the scene's order
         assert_eq!(island(0), vec![(2, 1), (2, WORLD), (1, 0)]);
         assert_eq!(island(1), vec![(3, 4)]);
-        assert_eq!(lists.starts.len(), n + 1 + 3);
+        // then the paths: each island is one (they are small), in its
+        // order; they share no body, so one colour holds both
+        let path = |p: usize| {
+            let at = n + 1 + 2 + 1 + p;
+            let (from, to) = (lists.starts[at] as usize, lists.starts[at + 1] as usize);
+            lists.refs[from..to].iter().map(|r| (r.body, r.partner)).collect::<Vec<_>>()
+        };
+        assert_eq!(path(0), island(0));
+        assert_eq!(path(1), vec![(3, 4)]);
+        assert_eq!(lists.colours, vec![0, 2]);
+        assert_eq!(lists.starts.len(), n + 1 + 3 + 3);
+    }
+
+    /// Every joint is in one path; no two paths of a colour share a body
+    /// that moves; a path follows its joints through shared bodies.
+    #[test]
+    fn joint_paths_cover_every_joint_and_colours_share_no_body() {
+        for (name, scene) in [
+            ("chain", crate::scenes::chain(21)),
+            ("bridge", crate::scenes::bridge(20)),
+            ("ragdoll", crate::scenes::ragdoll(3)),
+            ("joint_grid", crate::scenes::joint_grid(20)),
+            ("large joint_grid", crate::scenes::joint_grid(100)),
+            ("long chain", crate::scenes::chain(300)),
+        ] {
+            let lists = joint_lists(&scene);
+            let n = scene.bodies.len();
+            let first = n + 2 + lists.islands as usize;
+            let paths: Vec<&[JointRef]> =
+                lists.starts[first..].windows(2).map(|w| &lists.refs[w[0] as usize..w[1] as usize]).collect();
+            let moving = |b: u32| b != WORLD && !scene.bodies[b as usize].fixed;
+            let solved = scene.joints.iter().filter(|j| j.bodies.iter().any(|&b| b >= 0 && moving(b as u32))).count();
+            assert_eq!(paths.iter().map(|p| p.len()).sum::<usize>(), solved, "{name}: every joint once");
+            for p in &paths {
+                assert!(p.len() <= PATH_JOINTS, "{name}: a path of {}", p.len());
+                // a large island's paths go on through shared bodies
+                if solved > PATH_JOINTS {
+                    for w in p.windows(2) {
+                        assert!(w[1].body == w[0].partner || w[1].body == w[0].body, "{name}: a path jumps");
+                    }
+                }
+            }
+            for c in lists.colours.windows(2) {
+                let mut seen = std::collections::HashSet::new();
+                for p in &paths[c[0] as usize..c[1] as usize] {
+                    let bodies: std::collections::HashSet<u32> =
+                        p.iter().flat_map(|r| [r.body, r.partner]).filter(|&b| moving(b)).collect();
+                    for b in bodies {
+                        assert!(seen.insert(b), "{name}: body {b} in two paths of one colour");
+                    }
+                }
+            }
+            assert_eq!(*lists.colours.last().unwrap() as usize, paths.len(), "{name}");
+            eprintln!("{name}: {} joints in {} paths, {} colours", solved, paths.len(), lists.colour_count());
+        }
+        // a chain hung from the world is one path; a large grid's columns
+        // are one colour and its rows the other
+        assert_eq!(joint_lists(&crate::scenes::chain(21)).colour_count(), 1);
+        assert_eq!(joint_lists(&crate::scenes::joint_grid(100)).colour_count(), 2);
     }
 }

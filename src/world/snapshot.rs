@@ -48,8 +48,9 @@
 //! 1's velocity was), no rounding remainder, and the flag as it was. Their
 //! runs then continue as this build runs them, not bit for bit as the runs
 //! they were taken from. The scene hash covers the joint lists as the GPU
-//! holds them, which since version 3 include the joint islands: a version 1
-//! or 2 snapshot of a scene with joints is refused as another scene's.
+//! holds them (the islands and the paths `solve_joints` sweeps among them):
+//! a snapshot of a scene with joints taken by a build that listed them
+//! otherwise is refused as another scene's.
 
 use std::path::Path;
 

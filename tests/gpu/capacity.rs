@@ -25,12 +25,11 @@ fn a_scene_beyond_the_adapters_limits_is_refused_before_allocating() {
 }
 
 /// Where the driver ends an invocation's loops past a number of trips
-/// (lavapipe: 65535, summed over all of its loops), `solve_joints`, which
-/// sweeps an island's joints in one invocation, has room for islands of
-/// `loop_trips / 4` joints (2n trips for the rest times, 2n a sweep): a
-/// chain one link longer is refused, naming its joints; a chain at the
-/// limit steps, and one sweep a pass keeps its links joined. Elsewhere
-/// there is no such limit.
+/// (lavapipe: 65535, summed over all of its loops), `joint_rest`, which
+/// reads and writes an island's rest times in one invocation, has room for
+/// islands of `loop_trips / 2` joints: a chain one link longer is refused,
+/// naming its joints; a chain at the limit steps, swept along paths side
+/// by side, and keeps its links joined. Elsewhere there is no such limit.
 #[test]
 fn a_joint_island_too_large_for_the_drivers_loops_is_refused() {
     let Some(gpu) = crate::common::gpu() else { return };
@@ -38,7 +37,7 @@ fn a_joint_island_too_large_for_the_drivers_loops_is_refused() {
         eprintln!("{}: no loop limit known", gpu.describe());
         return;
     };
-    let most = (trips / 4) as usize;
+    let most = (trips / 2) as usize;
     match World::with_gpu(gpu.clone(), &scenes::chain(most + 1)) {
         Err(Error::Capacity(why)) => {
             assert!(why.contains(&format!("island of {} joints", most + 1)), "the reason names the island: {why}");

@@ -68,7 +68,11 @@ fn shared_structs_match_member_by_member() {
             substep,
             opaque_zero,
             island_count,
-            joint_sweeps
+            joint_sweeps,
+            path_first,
+            path_end,
+            _pad0,
+            _pad1
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, body });

@@ -239,6 +239,21 @@ fn box3ds_joint_grid_of_ten_by_ten_holds_together() {
     assert!(lowest > -9.01, "the grid sagged: its lowest ball is at y = {lowest} m, placed at -9");
 }
 
+/// Box3D's joint grid at its full size, 100 x 100 balls on 19 701 joints
+/// (one island, swept along paths side by side), holds together for 5 s.
+#[test]
+fn box3ds_joint_grid_at_its_full_size_holds_together() {
+    let side: usize = std::env::var("JOINT_GRID_SIDE").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
+    let scene = scenes::joint_grid(side);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(300).unwrap();
+    let state = w.read_state().unwrap();
+    let widest = joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max);
+    let lowest = state.iter().map(|b| b.position[1]).fold(f32::MAX, f32::min);
+    eprintln!("joint_grid {side} x {side} after 5 s: widest joint gap {:.2} mm, lowest ball at y = {lowest} m", widest * 1e3);
+    assert!(widest < 0.02, "a joint opened {widest} m");
+}
+
 /// The fastest body over `steps` steps (m/s), and the widest joint gap at the end.
 fn fastest_over(scene: &Scene, steps: u32) -> Option<(f32, f32)> {
     let mut w = world(scene)?;
