@@ -1,4 +1,4 @@
-//! Adding and removing bodies and joints while a world runs (issue 8).
+//! Adding and removing bodies and joints while a world runs.
 //!
 //! The GPU buffers are sized for the bodies a world holds, so an edit builds
 //! the world anew for the edited scene (new buffers, grid and joint lists,

@@ -1,4 +1,4 @@
-//! User input between steps (issue 8): impulses and forces at a point,
+//! User input between steps: impulses and forces at a point,
 //! poses, velocities, fixed/dynamic switches and radial explosions.
 //!
 //! Nothing is read back. Every call validates its arguments on the host
