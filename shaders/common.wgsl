@@ -103,7 +103,7 @@ struct Params {
     joint_sweeps: u32,       // the most sweeps along a path per solve_joints pass
     path_first: u32,         // the paths of this solve_joints pass's colour:
     path_end: u32,           //   path_first..path_end (joint_lists)
-    _pad0: u32,
+    path_count: u32,         // the paths of every colour
     _pad1: u32,
 }
 

@@ -367,8 +367,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
 // two bodies' generalised inverse masses along the gap, and moves the
 // displacement with the pose, as solve's snaps do. A pass makes up to
 // params.joint_sweeps such sweeps along each path (see
-// JOINT_SWEEPS_PER_SUBSTEP in src/world.rs), fewer along a long one
-// (SHORT_PATH).
+// JOINT_SWEEPS_PER_SUBSTEP in src/world.rs), fewer along one cut from a
+// large island (CUT_PATH_CLOSES in src/world/records.rs).
 
 // Close one joint: body j.body and its partner (or the world) move along
 // the gap between the two anchors until they meet, or until it has closed
@@ -418,15 +418,6 @@ fn close_joint(j: JointRef) {
         set_state(b, sb);
     }
 }
-
-// A path of up to SHORT_PATH joints (a chain, a bridge, a ragdoll) makes
-// the pass's joint_sweeps; a longer one (a row of a large island cut into
-// paths) min(joint_sweeps, PATH_CLOSES / 2n), at least one: a column of 100
-// joints of Box3D's grid makes 5, which the colours' turns make up for
-// (the grid of 100 x 100 opened 8 mm in 5 s at the defaults; 24 mm with a
-// quarter of PATH_CLOSES, at a quarter of the cost).
-const SHORT_PATH: u32 = 64u;
-const PATH_CLOSES: u32 = 1024u;
 
 // Pass "joint_rest", once a substep after its first solve, in place: an
 // island sleeps and wakes as one. Every body of it takes the least rest
@@ -487,9 +478,12 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // the sweeps forward then back, as one loop whose trip count is the
     // path's own (a loop bounded by a uniform alone makes lavapipe compile
-    // the kernel again for every dispatch)
+    // the kernel again for every dispatch), within the path's budget of
+    // joint closes (after the paths' starts: CUT_PATH_CLOSES for a path cut
+    // from a large island, none for a whole island)
     let n = end - first;
-    let sweeps = select(max(min(params.joint_sweeps, PATH_CLOSES / (2u * n)), 1u), params.joint_sweeps, n <= SHORT_PATH);
+    let closes = joint_start[params.body_count + params.island_count + 3u + params.path_count + path];
+    let sweeps = max(min(params.joint_sweeps, closes / (2u * n)), 1u);
     for (var t = 0u; t < 2u * n * sweeps; t = t + 1u) {
         let r = t % (2u * n);
         close_joint(joint_refs[select(first + r, end - 1u - (r - n), r >= n)]);

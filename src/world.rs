@@ -866,6 +866,7 @@ impl World {
                     opaque_zero: 0,
                     island_count: self.island_count,
                     joint_sweeps: JOINT_SWEEPS_PER_SUBSTEP.div_ceil(s.sweeps(substep as u32)),
+                    path_count: self.path_colours.last().copied().unwrap_or(0),
                     ..Params::default()
                 };
                 // the substep's own, then one per colour of the joint paths

@@ -122,7 +122,9 @@ pub struct Params {
     /// The paths of this `solve_joints` pass's colour: `path_first..path_end`.
     pub path_first: u32,
     pub path_end: u32,
-    pub _pad0: u32,
+    /// The paths of every colour (their budgets follow their starts in
+    /// `joint_start`).
+    pub path_count: u32,
     pub _pad1: u32,
 }
 

@@ -71,7 +71,7 @@ fn shared_structs_match_member_by_member() {
             joint_sweeps,
             path_first,
             path_end,
-            _pad0,
+            path_count,
             _pad1
         }
     );
