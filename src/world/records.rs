@@ -592,10 +592,8 @@ mod tests {
             let n = scene.bodies.len();
             let first = n + 2 + lists.islands as usize;
             let count = lists.path_count() as usize;
-            let paths: Vec<&[JointRef]> = lists.starts[first..first + count + 1]
-                .windows(2)
-                .map(|w| &lists.refs[w[0] as usize..w[1] as usize])
-                .collect();
+            let paths: Vec<&[JointRef]> =
+                lists.starts[first..first + count + 1].windows(2).map(|w| &lists.refs[w[0] as usize..w[1] as usize]).collect();
             let moving = |b: u32| b != WORLD && !scene.bodies[b as usize].fixed;
             let solved = scene.joints.iter().filter(|j| j.bodies.iter().any(|&b| b >= 0 && moving(b as u32))).count();
             // whole islands sweep as the pass asks, cut paths within a budget
