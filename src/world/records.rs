@@ -135,10 +135,11 @@ pub const PATH_JOINTS: usize = 128;
 /// The joint closes a path cut from a large island makes in one
 /// `solve_joints` pass at most: min(joint_sweeps, this / 2n) sweeps of its
 /// n joints, at least one (a whole island's path makes every sweep the
-/// pass asks). A column of 100 joints of Box3D's grid makes 5, which the
-/// colours' turns make up for: the grid of 100 x 100 opened 8 mm in 5 s at
-/// the defaults, 24 mm with a quarter of this at a quarter of the cost.
-pub const CUT_PATH_CLOSES: u32 = 1024;
+/// pass asks). A column of 100 joints of Box3D's grid makes 2, and the
+/// colours' turns carry the rest: the grid of 100 x 100 opened 7.4 mm in 5
+/// s at the defaults, 7.5 with 3 sweeps a pass, 8.0 with 5 at 2.8 times
+/// the cost, 24 with one.
+pub const CUT_PATH_CLOSES: u32 = 512;
 
 impl JointLists {
     /// The most joints one island holds (0 without joints), of a scene of
