@@ -464,7 +464,9 @@ impl World {
         let n = scene.bodies.len();
         check_capacity(&gpu, n)?;
         let joints = joint_lists(scene);
-        check_islands(&gpu, &joints, n)?;
+        if scene.settings.sleeping {
+            check_islands(&gpu, &joints, n)?;
+        }
         let settings = scene.settings;
         let device = &gpu.device;
         let count = n.max(1); // wgpu buffers may not be empty
@@ -1355,11 +1357,12 @@ fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
     Ok(())
 }
 
-/// Whether `joint_rest` can keep every joint island's rest time: one
-/// invocation reads and writes an island's, and where the driver ends an
-/// invocation's loops past `Gpu::loop_trips` (lavapipe), an island of n
-/// joints takes 2n trips. (The sweeps go along paths of at most
-/// `PATH_JOINTS` joints, which any island is cut into.)
+/// Whether `joint_rest` can keep every joint island's rest time (where
+/// bodies sleep; it runs only then): one invocation reads and writes an
+/// island's, and where the driver ends an invocation's loops past
+/// `Gpu::loop_trips` (lavapipe), an island of n joints takes 2n trips.
+/// (The sweeps go along paths of at most `PATH_JOINTS` joints, which any
+/// island is cut into.)
 fn check_islands(gpu: &Gpu, joints: &JointLists, bodies: usize) -> Result<(), Error> {
     let (Some(trips), largest) = (gpu.loop_trips(), joints.largest_island(bodies)) else { return Ok(()) };
     let most = trips / 2;
@@ -1367,7 +1370,8 @@ fn check_islands(gpu: &Gpu, joints: &JointLists, bodies: usize) -> Result<(), Er
         return Err(Error::Capacity(format!(
             "joints: an island of {largest} joints (bodies joined to each other, directly or through others) is more \
              than this adapter can keep asleep or awake as one: one invocation reads an island's rest times, and {} \
-             ends an invocation's loops after 65535 trips, room for islands of at most {most} joints",
+             ends an invocation's loops after 65535 trips, room for islands of at most {most} joints (with \
+             settings.sleeping off there is no such limit)",
             gpu.info.name
         )));
     }
