@@ -157,11 +157,6 @@ impl JointLists {
     pub fn colour_count(&self) -> u32 {
         self.colours.len().saturating_sub(1) as u32
     }
-
-    /// The most paths one colour holds.
-    pub fn widest_colour(&self) -> u32 {
-        self.colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0)
-    }
 }
 
 pub fn joint_lists(scene: &Scene) -> JointLists {
