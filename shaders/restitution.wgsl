@@ -82,10 +82,14 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     let threshold = max(2.0 * length(params.gravity) * params.dt, RESTITUTION_THRESHOLD);
     let mu = combined_friction(ea, eb);
     let e = combined_restitution(ea, eb);
-    // each contact cuts at most its share of the sliding at either end
-    // (friction_split)
-    let split_a = select(1.0, friction_split(a, 1.0), ea.moves);
-    let split_b = select(1.0, friction_split(b, 1.0), eb.moves);
+    // against an end that stays, each contact cuts at most its share of the
+    // sliding (friction_split; read only then, and never both ends stay here)
+    var split = 1.0;
+    if (!eb.moves) {
+        split = friction_split(a, 1.0);
+    } else if (!ea.moves) {
+        split = friction_split(b, 1.0);
+    }
     // summed over the points: the velocity change asked of b (a gets the
     // opposite), times the inverse masses later, and its moments; the
     // bounces apart, with the sum of their points' 1 / w
@@ -125,9 +129,9 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
             // its contact point moves by 1 / m + r^2 / I = 3.5 / m an
             // impulse, along n by 1 / m; a box flat on a face has the same
             // inverse mass both ways at its corners)
+            let w_t = end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t);
             let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
-            let w_split = end_inv_mass(ea, ra, t) * split_a + end_inv_mass(eb, rb, t) * split_b;
-            let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / w_split);
+            let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / (split * w_t));
             impulse = impulse + t * j;
             acted = true;
         }

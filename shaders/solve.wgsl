@@ -104,16 +104,12 @@ const SUPPORT_SPEED: f32 = 0.2;
 // piles creeping up to 4 cm a second. Not for a jointed body: its joints,
 // closed after each sweep, pull it back against weakened pushes (ragdolls
 // on a pile kept a limb bobbing 14 cm for seconds).
-// Body i's splits in a manifold (friction's, the normal pushes'): friction
-// is split against every partner (friction_split), the normal pushes only
-// against an end that stays (read only then).
+// Body i's splits in a manifold (friction's, the normal pushes'): 1 unless
+// the other end stays (and read only then).
 fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
     var splits = vec2<f32>(1.0);
-    if (i != GROUND) {
-        splits.x = friction_split(i, params.relaxation);
-        if (!partner_moves) {
-            splits.y = pair_meta[i].normal_split;
-        }
+    if (!partner_moves && i != GROUND) {
+        splits = vec2<f32>(friction_split(i, params.relaxation), pair_meta[i].normal_split);
     }
     return splits;
 }
