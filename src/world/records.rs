@@ -162,20 +162,11 @@ impl JointLists {
 pub fn joint_lists(scene: &Scene) -> JointLists {
     let n = scene.bodies.len();
     let movable = |b: i32| b >= 0 && !scene.bodies[b as usize].fixed;
-    let end = |j: &crate::scene::Joint, me: usize| {
-        let other = j.bodies[1 - me];
-        JointRef {
-            local_self: j.anchors[me],
-            partner: if other < 0 { WORLD } else { other as u32 },
-            local_partner: j.anchors[1 - me],
-            body: j.bodies[me] as u32,
-        }
-    };
     let mut per_body: Vec<Vec<JointRef>> = vec![Vec::new(); n];
     for j in &scene.joints {
         for me in 0..2 {
             if j.bodies[me] >= 0 {
-                per_body[j.bodies[me] as usize].push(end(j, me));
+                per_body[j.bodies[me] as usize].push(joint_end(j, me));
             }
         }
     }
@@ -247,7 +238,7 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
                 joint_done[k] = true;
                 let j = &scene.joints[k];
                 let me = if j.bodies[0] == b as i32 { 0 } else { 1 };
-                refs.push(end(j, me));
+                refs.push(joint_end(j, me));
                 island_order.last_mut().expect("the island begun above").push((k, b as u32));
                 let other = j.bodies[1 - me];
                 if movable(other) && !reached[other as usize] {
@@ -272,6 +263,17 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
     JointLists { starts, refs, islands, colours }
 }
 
+/// Joint `j` seen from its end `me` (0 or 1).
+fn joint_end(j: &crate::scene::Joint, me: usize) -> JointRef {
+    let other = j.bodies[1 - me];
+    JointRef {
+        local_self: j.anchors[me],
+        partner: if other < 0 { WORLD } else { other as u32 },
+        local_partner: j.anchors[1 - me],
+        body: j.bodies[me] as u32,
+    }
+}
+
 /// The joints cut into coloured paths (see `JointLists`), from the islands'
 /// joints in their order (each joint with the body it is seen from);
 /// `touching`: the joints each movable body takes part in. Returns
@@ -279,17 +281,8 @@ pub fn joint_lists(scene: &Scene) -> JointLists {
 /// where each colour begins.
 fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usize>]) -> (Vec<(Vec<JointRef>, bool)>, Vec<u32>) {
     let movable = |b: u32| b != WORLD && !scene.bodies[b as usize].fixed;
-    let end_at = |k: usize, at: u32| -> JointRef {
-        let j = &scene.joints[k];
-        let me = usize::from(j.bodies[0] != at as i32);
-        let other = j.bodies[1 - me];
-        JointRef {
-            local_self: j.anchors[me],
-            partner: if other < 0 { WORLD } else { other as u32 },
-            local_partner: j.anchors[1 - me],
-            body: at,
-        }
-    };
+    // joint k seen from its end at body `at`
+    let end_at = |k: usize, at: u32| joint_end(&scene.joints[k], usize::from(scene.joints[k].bodies[0] != at as i32));
     let mut taken = vec![false; scene.joints.len()];
     // the joint at body `at` (a movable one) not yet taken that goes on most
     // nearly straight from `from` (where, in its frame, the path came in;
@@ -314,8 +307,6 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         Some((k, r))
     };
     let mut paths: Vec<(Vec<JointRef>, Vec<u32>, bool)> = Vec::new();
-    // paths start where the islands are held (a joint to the world or a
-    // fixed body), so that one sweeps outward from its anchor
     // an island of at most PATH_JOINTS joints is one path, in its order
     // (outward from where it is held): a chain, a bridge or a ragdoll is
     // swept whole, its parallel joints (a bridge's two ropes) together
@@ -325,7 +316,9 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         island.iter().for_each(|&(k, _)| taken[k] = true);
         paths.push((path, bodies, true));
     }
-    // a larger one is cut into paths that start where it is held
+    // a larger one is cut into paths, the first ones starting where it is
+    // held (a joint to the world or a fixed body), so that they sweep
+    // outward from their anchors
     let order: Vec<(usize, u32)> = islands.iter().filter(|i| i.len() > PATH_JOINTS).flatten().copied().collect();
     let anchored = order.iter().filter(|&&(k, at)| !movable(end_at(k, at).partner));
     for &(k, at) in anchored.chain(&order) {
@@ -372,21 +365,13 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         }
         colour_of.push(c);
     }
+    // the paths by colour, in path order within one (a stable sort)
+    let mut by_colour: Vec<usize> = (0..paths.len()).collect();
+    by_colour.sort_by_key(|&p| colour_of[p]);
     let count = colour_of.iter().max().map_or(0, |&c| c + 1);
-    let mut colours = vec![0u32];
-    let mut ordered = Vec::with_capacity(paths.len());
+    let colours = (0..=count).map(|c| colour_of.iter().filter(|&&pc| pc < c).count() as u32).collect();
     let mut paths: Vec<Option<(Vec<JointRef>, bool)>> = paths.into_iter().map(|(p, _, whole)| Some((p, whole))).collect();
-    for c in 0..count {
-        for (p, &pc) in colour_of.iter().enumerate() {
-            if pc == c {
-                ordered.push(paths[p].take().expect("each path once"));
-            }
-        }
-        colours.push(ordered.len() as u32);
-    }
-    if count == 0 {
-        colours.clear();
-    }
+    let ordered = by_colour.into_iter().map(|p| paths[p].take().expect("each path once")).collect();
     (ordered, colours)
 }
 
