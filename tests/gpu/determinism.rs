@@ -9,13 +9,9 @@ use verlet::{scenes, World};
 /// `cubes --count 200 --seed 1`, 300 steps of the default settings.
 const STEPS: u64 = 300;
 
-/// FNV-1a 64 of `read_raw`'s bytes after `STEPS` steps on lavapipe as
-/// `PINNED_ON` names it (its vector width follows the CPU, and with it the
-/// rounding). Other adapters round differently and are only reported.
-/// Any change to the step's arithmetic (shaders, settings defaults, the
-/// cubes scene) moves it on purpose: check the change, then pin the value
-/// the failure prints (git log says what moved it and why). Last moved by
-/// dynamic friction bounded on the impulse (restitution.wgsl).
+/// FNV-1a 64 of `read_raw`'s bytes after `STEPS` steps on the lavapipe
+/// `PINNED_ON` names; a change to the step's arithmetic moves it on purpose
+/// (pin the value the failure prints; git log says why it moved).
 const PINNED_LAVAPIPE: u64 = 0x8495_2691_e9d7_6b2d;
 /// The adapter name and driver the hash was pinned on.
 const PINNED_ON: (&str, &str) = ("llvmpipe (LLVM 15.0.6, 256 bits)", "Mesa 22.3.6 (LLVM 15.0.6)");
