@@ -1,7 +1,7 @@
-// The step's bindings. Each pass binds those its entry point uses (its own
-// layout, src/step/mod.rs), in two bind groups, A->B and B->A, which differ
-// only in which state buffer is state_in and which state_out (made again
-// when the pools are).
+// The step's bindings and the helpers that read them (common.wgsl binds
+// nothing). Each pass binds those its entry point uses (src/step/mod.rs), in
+// two bind groups, A->B and B->A, which differ only in which state buffer is
+// state_in and which state_out.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> props: array<PropsWords>;
 @group(0) @binding(2) var<storage, read> state_in: array<StateWords>;
@@ -62,23 +62,16 @@
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 
 // The most trips an invocation's loops may take, summed (`Gpu::loop_trips`):
-// lavapipe ends every loop of an invocation once their trips sum to 65535,
-// silently (ARCHITECTURE.md, Adding a stage, 8). Unlimited elsewhere.
+// lavapipe silently ends them at 65535 (ARCHITECTURE.md, Adding a stage, 8).
 override LOOP_TRIPS: u32 = 0xffffffffu;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1
 @group(0) @binding(14) var<storage, read> joint_refs: array<JointRef>;          // 2 per joint
 
-// The busiest buffers are bound as vec4 words, not as the structs they
-// hold (the same bytes: tests/gpu/layouts.rs checks each pair), and read
-// and written through the functions below. Lavapipe runs every load or
-// store of a storage buffer as a loop over the lanes of a vector, one loop
-// for a vec4 as for a single word; a struct is loaded member by member, so
-// BodyState's six members took six loops where its four words take four.
-// Measured on a 10k pile (sleeping off, 150 steps, medians of four runs in
-// turns, same bits): the step's passes went from 41.5 to 38.2 ms, solve
-// 6.0 -> 4.9, integrate 2.3 -> 2.0, narrowphase 4.4 -> 3.7, pairs_count
-// 4.4 -> 4.0. A member that is not read is not loaded either way.
+// The busiest buffers are bound as vec4 words (the same bytes as their
+// structs; tests/gpu/layouts.rs checks each pair) and read and written
+// through the functions below: lavapipe loads a struct member by member, one
+// loop over the lanes each, and a vec4 in one loop (docs/lavapipe.md).
 
 // ManifoldPoints as stored: point q in at[2q] (local_a, pushed) and
 // at[2q + 1] (local_b, _pad0).
@@ -171,14 +164,10 @@ fn set_rest_time(i: u32, rest: f32) {
 // The body that invocation k of a body pass (integrate, solve,
 // restitution) works on, or NONE: the k-th body contact_lists listed this
 // step, in sorted[body_count ..] (status[16] of them; pairs_count fills the
-// rest of the run with NONE, so no invocation reads the count: an atomic
-// load is a loop over the lanes on lavapipe). World::run_stages without
-// contact_lists lists every body itself. Every body is listed but a
-// sleeper that the step leaves as it is (see `sleeps_held` in
-// narrowphase.wgsl): its pose is then the same in both state buffers, as
-// every pass would have copied it, and a resting pile with a few bodies
-// awake pays these passes for the few. The list's order depends on thread
-// timing, but each body's result depends on its own data alone.
+// rest of the run with NONE, so no invocation loads the atomic count). Every
+// body is listed but a sleeper the step leaves as it is (`sleeps_held`), whose
+// pose is the same in both state buffers, so a resting pile pays these passes
+// for its few awake bodies. The order depends on thread timing; no result does.
 fn listed_body(k: u32) -> u32 {
     return select(NONE, sorted[params.body_count + k], k < params.body_count);
 }
@@ -199,10 +188,9 @@ fn large_body(k: u32) -> u32 {
     return sorted[params.body_count - params.large_count + k];
 }
 
-// Workgroups in a row of an indirect dispatch over the pairs or the
-// manifolds: the device's limit for one dimension (StepPipelines sets it).
-// A pile of a million cubes has more than 65535 x WORKGROUP pairs, so those
-// dispatches come in rows (y) of at most this many workgroups (x).
+// Workgroups in a row of an indirect dispatch over the pairs or manifolds: the
+// device's limit for one dimension (StepPipelines sets it); a million cubes'
+// pairs need several rows (y) of at most this many workgroups (x).
 override DISPATCH_ROW: u32 = 65535u;
 
 // Writes the indirect dispatch of `count` invocations at status[at ..
@@ -234,22 +222,12 @@ fn pool_slot(k: u32, used: u32) -> u32 {
     return select(k, arrayLength(&manifolds) - top + (k - bottom), k >= bottom);
 }
 
-// Helpers that read the bindings (common.wgsl binds nothing).
-
-// The manifold pool is larger than one storage binding may be in a big
-// scene (lavapipe binds at most 128 MiB: 838 860 manifolds of 160 bytes, and
-// a pile of a million cubes wants more than two million), so it is split:
-// the headers (32 bytes) in `manifolds`, the points (128 bytes) in up to
-// four parts, the snaps (64 bytes a slot) in up to two. Slot k's points lie
-// in part k / P at k % P, P the first part's length (every part but the
-// last is full; a part not needed holds one entry and is never read). The
-// manifold passes run over consecutive slots, so the lanes of a vector
-// take the same part but where one part ends. Until a pool first needs
-// parts (every scene but the largest never does) the passes run with
-// POOL_SPLIT off, which folds every access below to one load or store with
-// no branch (the branches cost the contact passes a sixth of their time);
-// World's make_pools compiles the passes that touch the parts again with
-// it on then, and they stay so (right at any size).
+// The manifold pool may be larger than one storage binding (lavapipe binds at
+// most 128 MiB), so it is split: headers in `manifolds`, points in up to four
+// parts, snaps in up to two; slot k's points lie in part k / P at k % P, P the
+// first part's length. Until a pool first needs parts the passes run with
+// POOL_SPLIT off, which folds every access below to one load or store (the
+// branches cost the contact passes a sixth); make_pools then recompiles them.
 override POOL_SPLIT: bool = false;
 
 // Where slot k's points lie: (part, index in it).
@@ -331,15 +309,11 @@ fn set_snap(r: u32, s: EndSnap) {
     }
 }
 
-// Sleeping (settings.sleeping; the paper has none). A body that has been
-// slower than SLEEP_SPEED while touching something for params.sleep_after
-// seconds sleeps: integrate holds it still, without gravity, the solve and
-// restitution passes leave it as it is, and every awake body treats it as
-// fixed. It wakes when an awake body touching it moves faster than
-// WAKE_SPEED or lies more than WAKE_DEPTH inside it, and every body wakes
-// after any user input or edit. BodyState
-// rest_time counts the seconds at rest. Bodies on joints sleep and wake as
-// their whole joint island (see solve_joints), held by the joints.
+// Sleeping (settings.sleeping; the paper has none): a body slower than
+// SLEEP_SPEED while touching something for params.sleep_after seconds sleeps:
+// held still and treated as fixed by awake bodies (a joint island as one). It
+// wakes when a body touching it moves faster than WAKE_SPEED or lies
+// WAKE_DEPTH inside it, and on any input or edit.
 fn asleep(s: BodyState) -> bool {
     return params.sleep_after > 0.0 && s.rest_time >= params.sleep_after;
 }
@@ -363,21 +337,11 @@ fn point_speed(s: BodyState, p: BodyProps) -> f32 {
     return (length(s.disp) + spin * p.half_extents.w) / params.dt_prev;
 }
 
-// Friction against ends that stay. A body held by k such ends (the ground,
-// fixed or sleeping bodies, pair_meta's `held`) had each of them undo its
-// whole slide, and solve relaxes their sum by c_r: c_r k times the slide,
-// which for k > 2 at c_r = 0.5 overshoots, and a body wedged between
-// sleepers (seven manifolds) then jittered at 7 cm/s for good, awake. Each
-// such contact now counts the body's inverse mass max(1, c_r k) times (mass
-// splitting), so together they undo the slide once. 1000 cubes piled (seeds
-// 7 to 14), farthest move of any cube in the second after 15 s: 0.1 to 2.2
-// cm before, at most 0.2 cm after (every cube asleep in three of them).
-// Dynamic friction (restitution.wgsl) splits what stops the sliding the
-// same way, by max(1, k) as nothing relaxes its sum (each contact's own
-// Coulomb budget stays whole): there each such contact cut all the sliding
-// left, k times over, and a cube wedged between sleepers shook sideways
-// every other step at 0.13 m/s. Normal pushes split so too (solve.wgsl's
-// stay_splits).
+// Friction against ends that stay (the ground, fixed or sleeping bodies): a
+// body held by k of them (pair_meta's `held`) has each undo its whole slide,
+// which solve's relaxation sums to c_r k slides, an overshoot; so each counts
+// the body's inverse mass max(1, c_r k) times (mass splitting). Dynamic
+// friction splits by max(1, k); normal pushes: solve.wgsl's stay_splits.
 fn friction_split(i: u32, relaxation: f32) -> f32 {
     if (i == GROUND) {
         return 1.0;

@@ -170,10 +170,9 @@ const AXIS_FACE: u32 = 1u;
 const AXIS_EDGE: u32 = 2u;
 
 fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, margin: f32) -> BoxAxis {
-    // Everything in a's frame: column j of r is b's axis j, t is b's centre.
-    // All 15 axes are tested without an early exit and without indexing an
-    // array: lanes packed into one vector run the same code whatever their
-    // pair, and most candidate pairs touch.
+    // In a's frame (column j of r is b's axis j, t is b's centre), all 15 axes
+    // with no early exit and no array indexing: a vector's lanes run the same
+    // code whatever their pair, and most candidate pairs touch.
     let axes_a = box_axes(qa);
     let axes_b = box_axes(qb);
     let ma = mat3x3<f32>(axes_a[0], axes_a[1], axes_a[2]);
@@ -238,9 +237,8 @@ fn box_box_edge(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let n = axis.normal;
     let edge_i = axis.edge_i;
     let edge_j = axis.edge_j;
-    // the edge of a farthest along n, the edge of b farthest along -n (the
-    // axes picked by select, not by an index: an array indexed by a value
-    // that differs per lane is slow to run and to compile on lavapipe)
+    // the edge of a farthest along n, the edge of b farthest along -n (axes
+    // picked by select: a per-lane array index is slow on lavapipe)
     var pa = ca;
     var pb = cb;
     for (var k = 0u; k < 3u; k = k + 1u) {
@@ -313,15 +311,11 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let nf = to_face * inc_axis;
     let slope = -nf.xy / nf.z;
 
-    // The corners of the incident face's part within the reference face
-    // (|x| <= half.x, |y| <= half.y), found without clipping in arrays
-    // (lavapipe keeps dynamically indexed arrays in memory), as twelve
-    // candidates in three groups of four: where each edge enters the
-    // reference face (its start when that lies on it) and where it leaves
-    // it before its end, from the part t0..t1 of the edge within both slabs
-    // (Liang-Barsky); then the reference face's corners strictly inside the
-    // incident face (on the inner side of its four edges, which the face's
-    // winding cross2(du, dv) tells).
+    // The corners of the incident face's part within the reference face, found
+    // without clipping in arrays (lavapipe keeps dynamically indexed arrays in
+    // memory), as twelve candidates in three groups of four: where each edge
+    // enters and leaves the reference face (Liang-Barsky on the two slabs),
+    // then the reference face's corners strictly inside the incident face.
     let half = vec2<f32>(ref_h[side_u], ref_h[side_v]);
     let span_x = slab_span(px, ex, half.x);
     let span_y = slab_span(py, ey, half.y);
@@ -458,8 +452,7 @@ fn area_added(g: Candidates, p0: vec2<f32>, p1: vec2<f32>, p2: vec2<f32>, side: 
 
 // The manifold of a pair of which at least one is a sphere. A box and a
 // sphere are measured box first, in one call for either order (one copy of
-// box_sphere in the kernel: lavapipe's compile time grows steeply with a
-// kernel's size), and flipped back when the sphere came first.
+// box_sphere in the kernel), and flipped back when the sphere came first.
 fn collide_with_sphere(a: Shape, b: Shape, margin: f32) -> Manifold {
     if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_SPHERE) {
         return sphere_sphere(a.centre, a.half.x, b.centre, b.half.x, margin);

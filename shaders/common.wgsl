@@ -1,26 +1,15 @@
 // Types and maths that bind nothing, shared by every compute pass and the
-// renderer: the body layout, the per-step parameters, the contact records
-// and the quaternion helpers. Every struct here has a #[repr(C)] twin in
-// src/gpu/types.rs, checked member by member by tests/gpu/layouts.rs. The
-// constants shared with Rust (NONE, GROUND, WORLD, HELD, MAX_POINTS,
-// SHAPE_*, FLAG_FIXED, GRID_BODY, LARGE_BODY, WORKGROUP, SCAN_BLOCK, the
-// fault codes and limits) are not written here: src/gpu/shaders.rs writes
-// them from the Rust values, before this file, in every module. Helpers
-// that read the step's bindings live in bindings.wgsl.
+// renderer: the body layout, the per-step parameters, the contact records and
+// the quaternion helpers. Every struct has a #[repr(C)] twin in
+// src/gpu/types.rs (tests/gpu/layouts.rs checks them). The constants shared
+// with Rust (NONE, GROUND, WORKGROUP, the fault codes and limits, ...) are
+// written before this file from the Rust values (src/gpu/shaders.rs).
 
-// Pose of one body: what swaps between the two state buffers every pass.
-// 64 bytes. Quaternions are (x, y, z, w).
-//
-// The translation is kept as the displacement x_n - x_(n-1) rather than the
-// previous position: the same Verlet algebra, but the velocity disp / h no
-// longer comes from the difference of two large numbers (in f32 a position
-// near 100 m is held to 8e-6 m, while gravity adds g h^2 = 3e-4 m per
-// substep: a projectile 100 m up strayed 15 cm from its parabola in 2 s).
-// Every snap that moves pos moves disp with it, as moving pos while the
-// previous position stayed did. `pos_low` keeps what rounding dropped from
-// pos when integrate added the displacement (see `pos_remainder`): at 1 km
-// the f32 grid is 6e-5 m, and a steady horizontal displacement rounded the
-// same way every substep (21 mm in 2 s at 8 substeps).
+// Pose of one body: what swaps between the two state buffers every pass. 64
+// bytes; quaternions are (x, y, z, w). The displacement x_n - x_(n-1) is kept
+// instead of the previous position, so the velocity disp / h is not the
+// difference of two large f32 numbers, and `pos_low` keeps what rounding
+// dropped from pos (docs/decisions/integration.md).
 struct BodyState {
     pos: vec3<f32>,      // centre of mass (m)
     rest_time: f32,      // seconds at rest (see `asleep`)
@@ -54,9 +43,8 @@ fn pack_remainder(r: vec3<f32>, x: vec3<f32>, flags: u32) -> u32 {
 }
 
 // What rarely changes: shape, mass and material. 64 bytes. What a contact
-// reads of a body (the contact passes' `contact_end`) lies in the second
-// and third 16 bytes: its inverse inertia and mass, then its material,
-// shape and flags.
+// reads of a body (`contact_end`) lies in two of its four words: inverse
+// inertia and mass, then material, shape and flags.
 struct BodyProps {
     half_extents: vec4<f32>, // box: xyz half extents; sphere: radius in x; w = bounding radius
     inv_inertia: vec4<f32>,  // xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg)
@@ -144,17 +132,11 @@ struct ManifoldPoints {
 }
 
 // What one manifold asks of one of its bodies in a sweep, summed over its
-// points (solve_contacts, restitution_contacts): a move (m, or m/s in
-// restitution) and a turn (radians, or rad/s), world axes; `count`: 1 if
-// the manifold snapped the body (solve) or the points that acted
-// (restitution); `flags`: SNAP_PRESSED if a point has pushed in this
-// substep, above SETTLE_SHIFT the share of the move and turn that pushes
-// out old overlap deeper than SETTLE_SPEED allows, in 1/SETTLE_ONE, and
-// above SUPPORT_SHIFT (15 bits) the share of the move that pushes out
-// shallower old overlap, in 1/SUPPORT_ONE (solve only; see solve.wgsl). A
-// manifold's two, a's then b's, sit at 2 x its slot: a body reads its at
-// its contact reference (contact_ref; see `snap_of` in bindings.wgsl).
-// 32 bytes.
+// points: a move (m; m/s in restitution) and a turn (rad; rad/s), world axes;
+// `count`: 1 if it snapped the body (solve) or the points that acted
+// (restitution); `flags`: SNAP_PRESSED, the settling share above SETTLE_SHIFT
+// and the support share above SUPPORT_SHIFT (solve.wgsl). A manifold's two,
+// a's then b's, sit at 2 x its slot (`snap_of`). 32 bytes.
 struct EndSnap {
     dx: vec3<f32>,
     count: u32,
@@ -169,21 +151,12 @@ const SUPPORT_SHIFT: u32 = 1u;
 const SUPPORT_MASK: u32 = 0x7fffu;
 const SUPPORT_ONE: f32 = 32767.0;
 
-// Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
-// how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of
-// both, the cursor its incoming pairs are counted and listed by, whether
-// the narrowphase found it woken (WOKEN_NOW; integrate moves it to the
-// pose's WAKES bit), whether contacts can move it this step (MOVES, SLEEPS,
-// STAYS_FIXED), how many of its
-// pairs have a manifold (contact_lists: its list then starts with their
-// contact references, see `contact_ref`), and its bounds: the half extents
-// of its world box grown by its reach (how far any point of it may move
-// this step, m: the centre's move and `spin`, what its turn adds; see
-// grid.wgsl's reach_of and spin_reach_of),
-// how many of its manifolds are with an end that stays and what its normal
-// pushes against them count its inverse mass (contact_lists; the splits,
-// see bindings.wgsl's friction_split and solve.wgsl's stay_splits). The
-// entry after the last body holds the totals. 64 bytes.
+// Per-body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl,
+// contact_lists): the pairs it owns and is in and their prefix sums, the
+// cursor its incoming pairs are counted and listed by, WOKEN_NOW, MOVES /
+// SLEEPS / STAYS_FIXED, its manifolds, its bounds grown by its reach (`spin`:
+// the turn's part), and the splits against ends that stay (`held`,
+// `normal_split`). The entry after the last body holds the totals. 64 bytes.
 struct PairMeta {
     owned: u32,
     total: u32,
@@ -202,11 +175,8 @@ struct PairMeta {
 }
 
 // A grid body's bounds in the grid's order, as the pair walks read them
-// (grid_sort writes them; pairs.wgsl): its centre, its bounds (pair_meta's
-// bound and extent) and its index with pair_meta's moves in the top two
-// bits. One record a candidate, the bodies of a cell side by side: the
-// walks read their candidates' bounds from state_in and pair_meta before,
-// two records of 64 bytes apart. 32 bytes.
+// (grid_sort): centre, bound, extent, and its index with pair_meta's moves in
+// the top bits; one 32-byte record a candidate, a cell's side by side.
 struct CellBound {
     pos: vec3<f32>,
     bound: f32,
@@ -214,19 +184,15 @@ struct CellBound {
     body: u32,
 }
 
-// pair_meta[i].moves (grid_count): contacts can move the body this step
-// (awake, or asleep but woken by the last step's narrowphase); it sleeps
-// (and its pairs are found by the bodies that move: pairs.wgsl); it is
-// fixed.
+// pair_meta[i].moves: contacts can move the body this step (awake, or woken by
+// the last step's narrowphase); it sleeps (the movers find its pairs); it is fixed.
 const MOVES: u32 = 1u;
 const SLEEPS: u32 = 2u;
 const STAYS_FIXED: u32 = 0u;
 
-// pair_meta[i].woken's WOKEN_NOW (shared with Rust, whose snapshots keep
-// it): set by the narrowphase when an awake partner wakes a sleeper; moved
-// by integrate to the pose's WAKES bit (pos_low bit 30, shared with Rust),
-// which wakes the body one step later, once the pair list holds all of its
-// pairs again.
+// pair_meta[i].woken's WOKEN_NOW (shared with Rust): set by the narrowphase
+// when an awake partner wakes a sleeper; integrate moves it to the pose's
+// WAKES bit (pos_low bit 30), which wakes the body a step later.
 
 // A body's reference to one of its manifolds, as contact_lists leaves it in
 // the body's list: the manifold's index and which end of it the body is.
@@ -234,9 +200,8 @@ fn contact_ref(manifold: u32, is_b: bool) -> u32 {
     return 2u * manifold + u32(is_b);
 }
 
-// MAX_DEPENETRATION_SPEED (shared with Rust, src/world.rs): the fastest
-// (m/s) the solve pushes apart bodies that already overlapped at their
-// previous poses.
+// MAX_DEPENETRATION_SPEED (shared with Rust): the fastest (m/s) the solve
+// pushes apart bodies that already overlapped at their previous poses.
 
 // Points closer than this (m) still count as touching when restitution is
 // decided after the solve.
@@ -269,9 +234,8 @@ fn quat_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
 }
 
 // atan(x) for 0 <= x, without the builtin: Vulkan lets atan2, sin and cos be
-// off by 2^-11 absolute, which a spinning body integrates into drift. Two
-// half-angle reductions bring x under 0.27, where the odd series to x^11 is
-// good to about 1e-8.
+// off by 2^-11, which a spinning body integrates into drift. Two half-angle
+// reductions bring x under 0.27, where the series to x^11 is good to 1e-8.
 fn atan_precise(x_in: f32) -> f32 {
     var x = x_in;
     var scale = 1.0;
@@ -375,8 +339,7 @@ fn effective_inv_mass(p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>
     return p.inv_inertia.w + dot(rn, inv_inertia_world(rot, p.inv_inertia.xyz, rn));
 }
 
-// One body of a contact manifold as the contact passes see it: its poses
-// (the current one and how it got there from the previous),
+// One body of a contact manifold as the contact passes see it: its poses,
 // masses and material; the ground is an end at the origin with no mass.
 struct ContactEnd {
     pos: vec3<f32>,
@@ -393,12 +356,10 @@ struct ContactEnd {
     radius: f32,            // a sphere's radius (m); 0 for a box or the ground
 }
 
-// The point of an end a contact of normal `toward` (pointing from the end
-// to its partner) measures, in the end's frame: the stored point, or for a
-// sphere the point of its surface that faces the partner now. A sphere's
-// material point found at the step's start turns away with its spin (a
-// ball rolling at 13 m/s turns 0.7 rad a step), and one measured there
-// read the ball as above the ground while it sank through it.
+// The point of an end a contact of normal `toward` (from the end to its
+// partner) measures, in the end's frame: the stored point, or for a sphere the
+// point of its surface that faces the partner now (a fast roll turns the
+// stored material point away, and the ball sank through the ground).
 fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
     if (e.radius > 0.0) {
         return (toward * e.radius) * e.rot_m; // R^T (toward r)

@@ -1,14 +1,9 @@
-// User input between steps (src/world/input.rs): impulses, poses,
-// velocities and fixed/dynamic switches of single bodies (entry point
-// `apply_inputs`, one thread per run of ops on one body) and radial
-// explosions and wind (entry points `explode` and `wind`, one thread per
-// body). Assembled after
-// common.wgsl and bindings.wgsl, but it binds only state_out (the current
-// state buffer, rewritten in place) and what it declares below; and Verlet's velocity is
-// implicit, so a change of velocity is a change of the previous pose:
-// v = disp / h (disp = x_n - x_(n-1), see BodyState) and the turn
-// rot * prev_rot^* = exp(w h), where h is the substep that produced them
-// (input.substep_dt).
+// User input between steps (src/world/input.rs): `apply_inputs`, one thread
+// per run of ops on one body (impulses, poses, velocities, fixed/dynamic
+// switches), and `explode` and `wind`, one thread per body. It binds only
+// state_out (the current state, rewritten in place) and its own buffers.
+// Verlet's velocity is implicit, so a velocity change rewrites the previous
+// pose: v = disp / h and rot * prev_rot^* = exp(w h), h the last substep.
 
 struct InputHeader {
     gravity: vec3<f32>, // settings.gravity (m/s^2)

@@ -1,20 +1,16 @@
-// Off-screen rendering of a world (host code: src/render.rs).
-//
-// The bodies are drawn straight from the world's current state buffer,
-// bound read-only: one instance per body, a unit mesh (cube or icosphere)
-// scaled by the body's size, turned by its quaternion and moved to its
-// centre in the vertex shader. Nothing is read back to draw.
+// Off-screen rendering of a world (host code: src/render.rs). The bodies are
+// drawn straight from the world's current state buffer, bound read-only: one
+// instance per body, a unit mesh (cube or icosphere) scaled, turned and moved
+// to its centre in the vertex shader, so nothing is read back to draw.
 //
 // Two passes, four pipelines, all reading bind group 0:
 //   shadow_vertex                    the bodies' depth as the sun sees them
 //   body_vertex / body_fragment      the bodies, lit (sun, shadows, sky ambient)
 //   ground_vertex / ground_fragment  the plane y = height, with a grid
 //   joint_vertex / joint_fragment    optional joint lines, drawn on top
-// Group 1 (the shadow map) is bound in the second pass only.
-//
-// Depth is reversed (near = 1, far = 0, infinite far plane): a 32-bit float
-// depth buffer then keeps its precision from a body at the near plane to
-// the horizon of the ground.
+// Group 1 (the shadow map) is bound in the second pass only. Depth is reversed
+// (near = 1, far = 0, infinite far plane), so a 32-bit float depth buffer
+// keeps its precision from the near plane to the horizon.
 
 // BodyState, quat_rotate, SHAPE_BOX and SHAPE_SPHERE come from common.wgsl
 // and the shared constants, put before this file (src/render.rs).
@@ -102,9 +98,7 @@ fn shade(albedo: vec3<f32>, n: vec3<f32>, world_pos: vec3<f32>) -> vec3<f32> {
     return albedo * (ambient + sun * diffuse) + vec3<f32>(specular);
 }
 
-// ---------------------------------------------------------------------------
 // Bodies
-// ---------------------------------------------------------------------------
 
 // A body's point of the unit mesh in world coordinates.
 fn body_point(mesh_pos: vec3<f32>, b: RenderBody) -> vec3<f32> {
@@ -175,9 +169,7 @@ fn body_fragment(in: BodyOut) -> @location(0) vec4<f32> {
     return vec4<f32>(shade(albedo, n, in.world_pos), 1.0);
 }
 
-// ---------------------------------------------------------------------------
 // Ground
-// ---------------------------------------------------------------------------
 
 struct GroundOut {
     @builtin(position) clip: vec4<f32>,
@@ -224,9 +216,7 @@ fn ground_fragment(in: GroundOut) -> @location(0) vec4<f32> {
     return vec4<f32>(mix(lit, globals.background.rgb, fog), 1.0);
 }
 
-// ---------------------------------------------------------------------------
 // Joint lines
-// ---------------------------------------------------------------------------
 
 struct LineOut {
     @builtin(position) clip: vec4<f32>,
