@@ -12,16 +12,13 @@
 @group(0) @binding(6) var<storage, read_write> cell_start: array<u32>;          // hash_size + 1
 // the block totals of a prefix sum (grid.wgsl's scan): x for the grid, xy for the pairs
 @group(0) @binding(7) var<storage, read_write> block_sums: array<vec2<u32>>;
-// the grid's bodies sorted by cell, then (the last large_count entries,
-// written once when the world is made) the bodies kept out of the grid;
-// from body_count on, the step's listed bodies (see `listed_body`)
+// the grid's bodies sorted by cell, then the large bodies (written when the
+// world is made); from body_count on, the step's listed bodies (`listed_body`)
 @group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // 2 x body_count
 // the grid bodies' bounds in sorted's order (CellBound)
 @group(0) @binding(22) var<storage, read_write> cell_bounds: array<CellBoundWords>;  // body_count
-// the pair pipeline (pairs.wgsl, narrowphase.wgsl): candidate pairs, each
-// found once; the manifold pool, filled by need; each body's pair list,
-// body i's at body_pairs[pair_meta[i].list_start ..][.. pair_meta[i].total],
-// sorted by pair index
+// the pair pipeline (pairs.wgsl, narrowphase.wgsl): candidate pairs, the
+// manifold pool, and each body's contact list in body_pairs (from list_start)
 @group(0) @binding(10) var<storage, read_write> pairs: array<Pair>;             // pair capacity
 @group(0) @binding(11) var<storage, read_write> manifolds: array<ManifoldWords>; // manifold capacity
 // the manifolds' points, slot by slot, in up to four parts (`point_of`)
@@ -29,8 +26,7 @@
 @group(0) @binding(18) var<storage, read_write> points_1: array<PointsWords>;
 @group(0) @binding(19) var<storage, read_write> points_2: array<PointsWords>;
 @group(0) @binding(20) var<storage, read_write> points_3: array<PointsWords>;
-// what each manifold asks of its two bodies in a sweep (solve.wgsl,
-// restitution.wgsl), two a slot, in up to two parts (`snap_of`)
+// what each manifold asks of its two bodies in a sweep, in up to two parts (`snap_of`)
 @group(0) @binding(9) var<storage, read_write> snaps: array<SnapWords>;
 @group(0) @binding(21) var<storage, read_write> snaps_1: array<SnapWords>;
 @group(0) @binding(15) var<storage, read_write> pair_meta: array<PairMeta>;     // body_count + 1
@@ -73,8 +69,7 @@ override LOOP_TRIPS: u32 = 0xffffffffu;
 // through the functions below: lavapipe loads a struct member by member, one
 // loop over the lanes each, and a vec4 in one loop (docs/lavapipe.md).
 
-// ManifoldPoints as stored: point q in at[2q] (local_a, pushed) and
-// at[2q + 1] (local_b, _pad0).
+// ManifoldPoints as stored: point q in at[2q] (local_a, pushed), at[2q + 1] (local_b).
 struct PointsWords {
     at: array<vec4<f32>, 8>,
 }
@@ -85,13 +80,11 @@ struct ManifoldWords {
     ends: vec4<u32>, // a, b, clip_face, pair
 }
 
-// Manifold slot k's header.
 fn manifold_of(k: u32) -> ContactManifold {
     let w = manifolds[k];
     return ContactManifold(w.head.xyz, bitcast<u32>(w.head.w), w.ends.x, w.ends.y, w.ends.z, w.ends.w);
 }
 
-// Writes manifold slot k's header.
 fn set_manifold(k: u32, m: ContactManifold) {
     manifolds[k] = ManifoldWords(vec4<f32>(m.normal, bitcast<f32>(m.count)), vec4<u32>(m.a, m.b, m.clip_face, m.pair));
 }
@@ -102,13 +95,11 @@ struct CellBoundWords {
     b: vec4<f32>, // extent, body (its bits)
 }
 
-// The bounds at place k of the grid's order.
 fn cell_bound_of(k: u32) -> CellBound {
     let w = cell_bounds[k];
     return CellBound(w.a.xyz, w.a.w, w.b.xyz, bitcast<u32>(w.b.w));
 }
 
-// Writes the bounds at place k of the grid's order.
 fn set_cell_bound(k: u32, c: CellBound) {
     cell_bounds[k] = CellBoundWords(vec4<f32>(c.pos, c.bound), vec4<f32>(c.extent, bitcast<f32>(c.body)));
 }
@@ -121,7 +112,6 @@ struct PropsWords {
     d: vec4<u32>,   // kept_inv_mass, speed_limit (their bits), grid_class, _pad1
 }
 
-// Body i's properties.
 fn props_of(i: u32) -> BodyProps {
     let w = props[i];
     let f = bitcast<vec4<f32>>(vec4<u32>(w.c.xy, w.d.xy));
@@ -136,12 +126,10 @@ struct StateWords {
     prev_rot: vec4<f32>,
 }
 
-// The BodyState the words hold.
 fn state_from(w: StateWords) -> BodyState {
     return BodyState(w.a.xyz, w.a.w, w.b.xyz, bitcast<u32>(w.b.w), w.rot, w.prev_rot);
 }
 
-// Body i's state in state_in.
 fn state_of(i: u32) -> BodyState {
     return state_from(state_in[i]);
 }
@@ -151,12 +139,10 @@ fn out_state(i: u32) -> BodyState {
     return state_from(state_out[i]);
 }
 
-// Writes body i's state to state_out.
 fn set_state(i: u32, s: BodyState) {
     state_out[i] = StateWords(vec4<f32>(s.pos, s.rest_time), vec4<f32>(s.disp, bitcast<f32>(s.pos_low)), s.rot, s.prev_rot);
 }
 
-// Sets body i's rest_time in state_out alone.
 fn set_rest_time(i: u32, rest: f32) {
     state_out[i].a.w = rest;
 }
@@ -213,9 +199,8 @@ fn manifolds_used() -> u32 {
     return min(atomicLoad(&status[4]), arrayLength(&manifolds));
 }
 
-// The slot of the k-th stored manifold (k < used = manifolds_used()): the
-// pool fills from both ends (see new_manifold in narrowphase.wgsl), the
-// face contacts left for clipping at the top.
+// The slot of the k-th stored manifold (k < used): the pool fills from both
+// ends (new_manifold in narrowphase.wgsl), the face contacts to clip at the top.
 fn pool_slot(k: u32, used: u32) -> u32 {
     let top = min(atomicLoad(&status[6]), arrayLength(&manifolds));
     let bottom = used - top;
@@ -262,7 +247,6 @@ fn set_pushed(at: vec2<u32>, q: u32, pushed: f32) {
     }
 }
 
-// Stores slot k's points.
 fn store_points(k: u32, p: ManifoldPoints) {
     let at = point_slot(k);
     var w: PointsWords;
@@ -284,9 +268,8 @@ struct SnapWords {
     b: vec4<f32>, // dtheta, flags (its bits)
 }
 
-// The snap manifold `r >> 1` asks of the body that holds reference r: at
-// r itself (a's at 2 x the slot, b's next), in the first part of the snaps
-// or, past its end, the second.
+// The snap manifold `r >> 1` asks of the body that holds reference r (a's at 2 x
+// the slot, b's next), in the first part of the snaps or, past its end, the second.
 fn snap_of(r: u32) -> EndSnap {
     let per = arrayLength(&snaps);
     var w: SnapWords;
@@ -298,7 +281,6 @@ fn snap_of(r: u32) -> EndSnap {
     return EndSnap(w.a.xyz, bitcast<u32>(w.a.w), w.b.xyz, bitcast<u32>(w.b.w));
 }
 
-// Stores the snap at reference r (see snap_of).
 fn set_snap(r: u32, s: EndSnap) {
     let per = arrayLength(&snaps);
     let w = SnapWords(vec4<f32>(s.dx, bitcast<f32>(s.count)), vec4<f32>(s.dtheta, bitcast<f32>(s.flags)));
@@ -320,8 +302,7 @@ fn asleep(s: BodyState) -> bool {
 
 const SLEEP_SPEED: f32 = 0.05; // m/s
 const WAKE_SPEED: f32 = 0.2;   // m/s
-// An awake body this far inside a sleeper wakes it too (m): it is being
-// squeezed against something that cannot give way.
+// An awake body this far inside a sleeper wakes it (m): it squeezes it against something.
 const WAKE_DEPTH: f32 = 0.01;
 
 // Whether an awake body touching a sleeper at points `gap` apart (m) wakes it.
@@ -330,8 +311,7 @@ fn wakes(j: u32, gap: f32) -> bool {
     return !asleep(o) && (gap < -WAKE_DEPTH || point_speed(o, props_of(j)) > WAKE_SPEED);
 }
 
-// An upper bound of the speed of any point of a body over the last substep
-// (m/s): the centre's speed plus the spin times the bounding radius.
+// An upper bound of any point's speed over the last substep (m/s): centre plus spin x radius.
 fn point_speed(s: BodyState, p: BodyProps) -> f32 {
     let spin = length(quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot))));
     return (length(s.disp) + spin * p.half_extents.w) / params.dt_prev;
@@ -349,20 +329,17 @@ fn friction_split(i: u32, relaxation: f32) -> f32 {
     return max(1.0, relaxation * f32(pair_meta[i].held));
 }
 
-// Whether body i has a joint: its contacts then neither split their normal
-// pushes against ends that stay (contact_lists) nor settle or cap their
-// support (solve), as its joints pull it back against weakened pushes.
+// Whether body i has a joint: its contacts then neither split their normal pushes
+// against ends that stay nor settle or cap their support (docs/decisions/joints.md).
 fn is_jointed(i: u32) -> bool {
     return joint_start[i + 1u] > joint_start[i];
 }
 
-// Whether the contacts may move body i: awake and not fixed (ContactEnd's
-// `moves`).
+// Whether the contacts may move body i: awake and not fixed (ContactEnd's `moves`).
 fn contact_end_moves(i: u32) -> bool {
     return moves_by_contacts(state_of(i), props_of(i));
 }
 
-// The same, from the body's state and properties already read.
 fn moves_by_contacts(s: BodyState, p: BodyProps) -> bool {
     return !is_fixed(p) && !asleep(s);
 }
@@ -377,8 +354,7 @@ fn contact_end(i: u32) -> ContactEnd {
     let s = state_of(i);
     let p = props_of(i);
     let r = quat_to_mat(s.rot);
-    // a sphere's radius, read only for a sphere: where no lane holds one
-    // (a pile of boxes), lavapipe skips the load
+    // a sphere's radius, read only for a sphere: lavapipe skips the load where no lane has one
     var radius = 0.0;
     if (p.shape == SHAPE_SPHERE) {
         radius = props_of(i).half_extents.x;

@@ -27,16 +27,14 @@ fn remainder_unit(x: vec3<f32>) -> vec3<f32> {
     return bitcast<vec3<f32>>(exponent) * 2.3283064e-10; // 2^-32 = 2^-23 / 512
 }
 
-// What rounding dropped from pos.xyz (m): the true centre is pos + this.
-// Each coordinate is a signed 10-bit multiple of remainder_unit (bits 0-9 x,
-// 10-19 y, 20-29 z, offset by 512), so it holds about 1/1000 of a spacing.
+// What rounding dropped from pos.xyz (m): the true centre is pos + this. Each
+// coordinate a signed 10-bit multiple of remainder_unit (bits 0-9 x, 10-19 y, 20-29 z).
 fn pos_remainder(s: BodyState) -> vec3<f32> {
     let q = (vec3<u32>(s.pos_low) >> vec3<u32>(0u, 10u, 20u)) & vec3<u32>(0x3ffu);
     return (vec3<f32>(q) - 512.0) * remainder_unit(s.pos);
 }
 
-// pos_low for a remainder r (m) of the position x, with the HELD and WAKES
-// bits of `flags`.
+// pos_low for a remainder r (m) of the position x, with `flags`' HELD and WAKES bits.
 fn pack_remainder(r: vec3<f32>, x: vec3<f32>, flags: u32) -> u32 {
     let q = vec3<u32>(vec3<i32>(clamp(round(r / remainder_unit(x)), vec3<f32>(-511.0), vec3<f32>(511.0))) + 512);
     return q.x | (q.y << 10u) | (q.z << 20u) | (flags & (HELD | WAKES));
@@ -58,8 +56,7 @@ struct BodyProps {
     _pad1: u32,
 }
 
-// Velocities just after integration, before any constraint: the approach
-// velocities that restitution reflects. 32 bytes.
+// Velocities just after integration: the approach velocities restitution reflects. 32 bytes.
 struct Velocity {
     linear: vec4<f32>,  // m/s
     angular: vec4<f32>, // rad/s, world frame
@@ -95,17 +92,14 @@ struct Params {
     _pad1: u32,
 }
 
-// A candidate pair found by the broadphase (pairs.wgsl): body a owns it; b
-// is another body or GROUND. 8 bytes.
+// A candidate pair (pairs.wgsl): body a owns it; b is a body or GROUND. 8 bytes.
 struct Pair {
     a: u32,
     b: u32,
 }
 
-// One contact point of a pair: the point on each body in that body's own
-// frame (the ground's in world coordinates), and the normal push summed over
-// this substep's sweeps (m): its friction budget, written by the manifold's
-// solve_contacts invocation and emptied by restitution_contacts. 32 bytes.
+// One contact point: the point on each body in its own frame (the ground's in world
+// coordinates), and its friction budget: the normal push summed this substep (m). 32 bytes.
 struct ContactPoint {
     local_a: vec3<f32>,
     pushed: f32,
@@ -113,10 +107,8 @@ struct ContactPoint {
     _pad0: f32,
 }
 
-// A pair's contact manifold, found once per step: up to MAX_POINTS points
-// sharing one world normal, pointing from a to b (GROUND or a body). Its
-// header (32 bytes) here; its points at the same slot of the pool's point
-// parts (ManifoldPoints, see `point_of` in bindings.wgsl).
+// A pair's contact manifold, found once a step: up to MAX_POINTS points sharing one
+// normal, from a to b. Its 32-byte header; the points lie in the pool's parts (`point_of`).
 struct ContactManifold {
     normal: vec3<f32>,
     count: u32,
@@ -194,8 +186,7 @@ const STAYS_FIXED: u32 = 0u;
 // when an awake partner wakes a sleeper; integrate moves it to the pose's
 // WAKES bit (pos_low bit 30), which wakes the body a step later.
 
-// A body's reference to one of its manifolds, as contact_lists leaves it in
-// the body's list: the manifold's index and which end of it the body is.
+// A body's reference to one of its manifolds: the manifold's index and which end it is.
 fn contact_ref(manifold: u32, is_b: bool) -> u32 {
     return 2u * manifold + u32(is_b);
 }
@@ -203,12 +194,10 @@ fn contact_ref(manifold: u32, is_b: bool) -> u32 {
 // MAX_DEPENETRATION_SPEED (shared with Rust): the fastest (m/s) the solve
 // pushes apart bodies that already overlapped at their previous poses.
 
-// Points closer than this (m) still count as touching when restitution is
-// decided after the solve.
+// Points closer than this (m) still touch when restitution is decided after the solve.
 const CONTACT_SLOP: f32 = 0.002;
-// One end of a ball joint as the body at that end sees it: its anchor in its
-// own frame, the partner's anchor in the partner's frame (world coordinates
-// when the partner is WORLD). 32 bytes.
+// One end of a ball joint as the body at that end sees it: both anchors, each in its
+// body's frame (the world's in world coordinates). 32 bytes.
 struct JointRef {
     local_self: vec3<f32>,
     partner: u32,
@@ -260,16 +249,14 @@ fn quat_to_rotvec(q_in: vec4<f32>) -> vec3<f32> {
     if (s < 1e-12) {
         return 2.0 * q.xyz;
     }
-    // atan(s / w), or pi/2 - atan(w / s) past 45 degrees: one call of
-    // atan_precise, so one copy of it where this is inlined
+    // atan(s / w), or pi/2 - atan(w / s) past 45 degrees: one inlined atan_precise
     let small = s <= q.w;
     let a = atan_precise(select(q.w / s, s / q.w, small));
     let half_angle = select(1.5707964 - a, a, small);
     return q.xyz * (2.0 * half_angle / s);
 }
 
-// Unit quaternion of a rotation vector; a series for the small angles of one
-// step (see atan_precise for why not the builtins).
+// Unit quaternion of a rotation vector; a series for one step's small angles (atan_precise).
 fn quat_from_rotvec(v: vec3<f32>) -> vec4<f32> {
     let angle = length(v);
     let h = 0.5 * angle;
@@ -316,9 +303,8 @@ fn quat_to_mat(q: vec4<f32>) -> mat3x3<f32> {
                        vec3<f32>(xz + wy, yz - wx, 1.0 - xx - yy));
 }
 
-// World-frame inverse inertia as a matrix, from the rotation's matrix r:
-// R diag(inv_i) R^T. Made once for an end of a manifold, it spares each of
-// the manifold's pushes the two rotations inv_inertia_world makes.
+// World-frame inverse inertia as a matrix, R diag(inv_i) R^T from the rotation's
+// matrix r: made once for a manifold's end, it spares each push two rotations.
 fn world_inv_inertia(r: mat3x3<f32>, inv_i: vec3<f32>) -> mat3x3<f32> {
     return mat3x3<f32>(r[0] * inv_i.x, r[1] * inv_i.y, r[2] * inv_i.z) * transpose(r);
 }
@@ -367,8 +353,7 @@ fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
     return stored;
 }
 
-// Generalised inverse mass of an end for a unit push along dir at offset r;
-// 0 for an end the contacts may not move (the ground, fixed, asleep).
+// Generalised inverse mass of an end along dir at offset r; 0 for an end that stays.
 fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
     if (!e.moves) {
         return 0.0;
@@ -377,9 +362,8 @@ fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
     return e.inv_inertia.w + dot(rn, e.inv_i_world * rn);
 }
 
-// What a summed impulse-like vector j (through points at summed moments
-// `moment` = sum of r x j) asks of an end: its inverse mass times j, its
-// world inverse inertia times the moment (nothing for an end that stays).
+// What a summed impulse-like j (moments `moment` = sum of r x j) asks of an end:
+// inverse mass times j, world inverse inertia times the moment (nothing if it stays).
 fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, flags: u32) -> EndSnap {
     if (!e.moves) {
         return EndSnap(vec3<f32>(0.0), 0u, vec3<f32>(0.0), flags);
@@ -387,9 +371,8 @@ fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, flags: u
     return EndSnap(j * e.inv_inertia.w, count, e.inv_i_world * moment, flags);
 }
 
-// Restitution and friction of a contact: the larger restitution and the
-// geometric mean of the frictions (Box2D's rule); the ground's material is
-// settings.restitution and settings.friction.
+// A contact's material: the larger restitution and the geometric mean of the
+// frictions (Box2D's rule); the ground's is settings.restitution and .friction.
 fn combined_restitution(a: ContactEnd, b: ContactEnd) -> f32 {
     return max(a.restitution, b.restitution);
 }

@@ -43,13 +43,11 @@ fn in_grid(i: u32) -> bool {
     return grid_body(props_of(i));
 }
 
-// The same, from the body's properties already read.
 fn grid_body(p: BodyProps) -> bool {
     return p.grid_class == GRID_BODY;
 }
 
-// How far a body in state s may move in the coming step, all its substeps
-// (m): its last displacement, rescaled to this step, plus what gravity adds.
+// How far a body may move in the coming step (m): its last displacement, rescaled, and gravity.
 fn reach_of(s: BodyState) -> f32 {
     let steps = f32(params.substeps);
     let ratio = params.dt / params.dt_prev * steps;
@@ -82,14 +80,12 @@ fn box_size(extent: vec3<f32>) -> f32 {
     return max(extent.x, max(extent.y, extent.z));
 }
 
-// Whether a body of box size `size` is fast. A sleeper never is: it walks
-// no cells (and its reach is nil).
+// Whether a body of box size `size` is fast. A sleeper never is: it walks no cells.
 fn is_fast(size: f32, moves: u32) -> bool {
     return size > fast_size() && moves != SLEEPS;
 }
 
-// Half extents of a body's world box (state s, properties p): |R| h for a
-// box, the radius for a sphere.
+// Half extents of a body's world box: |R| h for a box, the radius for a sphere.
 fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(p.half_extents.x);
@@ -119,7 +115,6 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    // the body's state and properties, read once
     let s = state_of(i);
     let p = props_of(i);
     let reach = reach_of(s);
@@ -137,8 +132,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (!grid_body(p)) {
         return;
     }
-    // the pair walks of the bodies that move look for sleepers behind them
-    // too (pairs.wgsl); one store does, the rest see it set
+    // the movers' walks look for sleepers behind them too; one store sets it
     if (sleeps && atomicLoad(&status[11]) == 0u) {
         atomicStore(&status[11], 1u);
     }
@@ -217,9 +211,8 @@ fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_
     for (var h = first; h < end; h = h + 1u) {
         scan_write(h, scan_written(h) + before); // exclusive within the block
     }
-    // one block is the whole scan: its offset is 0 and it finishes the
-    // scan itself, so that scan_sums (and the grid's scan_add) need not run
-    // (`World::step_plan` leaves them out)
+    // one block is the whole scan: its offset is 0 and it finishes the scan
+    // itself, so scan_sums and scan_add need not run (`World::step_plan`)
     let whole = scan_len() <= SCAN_SPAN;
     if (lid.x == SCAN_BLOCK - 1u) {
         block_sums[wid.x] = select(scan_tmp[lid.x], vec2<u32>(0u), whole);
@@ -229,8 +222,7 @@ fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_
     }
 }
 
-// Writes the whole scan's total `sum` past the last entry and, for the
-// pairs, their count and the narrowphase's indirect dispatch.
+// Writes the total `sum` past the last entry and, for the pairs, their count and dispatch.
 fn finish_scan(sum: vec2<u32>) {
     scan_write(scan_len(), sum);
     if (SCAN_PAIRS) {
@@ -243,8 +235,7 @@ fn finish_scan(sum: vec2<u32>) {
 }
 
 // One workgroup turns the block totals into exclusive block offsets, each
-// invocation scanning a run of consecutive blocks first (nothing to do for
-// a scan of one block, which scan_blocks finished).
+// invocation scanning a run of blocks first (none for a scan of one block).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
     if (scan_len() <= SCAN_SPAN) {
@@ -294,8 +285,7 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     sorted[params.body_count + cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
 }
 
-// A grid body's key in its bucket: the low x side of its world box grown
-// by its reach (pair_meta's extent, written by grid_count).
+// A grid body's key in its bucket: the low x side of its grown world box.
 fn grid_key(i: u32) -> f32 {
     return state_of(i).pos.x - pair_meta[i].extent.x;
 }

@@ -12,11 +12,6 @@
 // sane pose; the step goes on. A run with no fault is bit-identical to one
 // without the check, and the host reads the flag only on request.
 
-// Sleeping (`asleep` in bindings.wgsl): a body sleeps after params.sleep_after
-// seconds slower than SLEEP_SPEED at every point while touching something
-// (HELD, set by solve); it wakes one step after the narrowphase finds an
-// awake partner waking it, and inputs and edits wake every body.
-
 // The WAKES bit body i's pose carries out of this substep: in the first, the
 // narrowphase's WOKEN_NOW (cleared for the next step), so the body wakes once
 // the pair list holds all its pairs again; in the others, as it came in. Only
@@ -55,7 +50,6 @@ fn moved() {
 // (BodyProps' speed_limit), which only the solver can do; checked while
 // params.speed_limits holds (nothing has added energy since the scene began).
 
-// (all_finite and near: common.wgsl)
 
 fn usable_rotation(q: vec4<f32>) -> bool {
     let d = dot(q, q);
@@ -127,8 +121,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         report_fault(i, fault);
         var at = vec3<f32>(0.0);
         let prev = s.pos - s.disp;
-        // the current position's finite coordinates (a NaN in one of them
-        // leaves pos - disp no better)
+        // the current position's finite coordinates (pos - disp is no better with a NaN)
         let kept = select(vec3<f32>(0.0), s.pos, (bitcast<vec3<u32>>(s.pos) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u));
         if (near(s.pos)) {
             at = s.pos;
@@ -179,8 +172,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ratio = dt / params.dt_prev;
     // eq. 12: damping keeps (1 - beta) of it
     let carry = s.disp * (ratio * (1.0 - params.linear_damping));
-    // constant acceleration: a dt (dt + dt_prev) / 2 is exact for any pair of
-    // steps and equals eq. 6's a dt^2 when dt does not change
+    // gravity: a dt (dt + dt_prev) / 2, exact for any pair of steps (eq. 6's a dt^2)
     let accel = params.gravity * (dt * 0.5 * (dt + params.dt_prev));
     let disp = carry + accel;
     // pos + disp by Knuth's TwoSum: what the last addition's rounding dropped is
@@ -192,8 +184,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pos_part = pos - add_part;
     let dropped = (s.pos - pos_part) + (add - add_part);
 
-    // eq. 7 with no torque: repeat the last rotation q_n q_{n-1}^*, scaled by
-    // the step ratio and damped by interpolation towards no rotation
+    // eq. 7 with no torque: repeat the last turn, rescaled and damped towards none
     let last = quat_mul(s.rot, quat_conj(s.prev_rot));
     let keep = ratio * (1.0 - params.angular_damping);
     let turn = select(quat_from_rotvec(quat_to_rotvec(last) * keep), last, keep == 1.0);

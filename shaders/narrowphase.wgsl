@@ -1,12 +1,10 @@
-// Pass "narrowphase", once per step after the pair list: one invocation per
-// candidate pair (indirect, over the pairs listed) finds the pair's manifold
-// (collide.wgsl) up to a speculative gap (how far the pair may close in the
-// step, so fast bodies meet walls instead of passing them), stores it in the
-// pool in the bodies' frames and lists it in both bodies' contact lists. Two
-// boxes get only their separating axis here; a face contact is stored pending
-// for narrowphase_clip. Ground pairs: narrowphase_ground. An awake partner
-// moving fast or deep in a sleeper wakes it (WOKEN_NOW). Then contact_lists
-// sorts each body's list. Why it is laid out so: docs/decisions/narrowphase.md.
+// Pass "narrowphase", once per step after the pair list, one invocation per
+// candidate pair: the pair's manifold (collide.wgsl) up to a speculative gap
+// (how far the pair may close in the step, so fast bodies meet walls), stored
+// in the pool in the bodies' frames and listed in both bodies' contact lists.
+// Two boxes get only their separating axis here; a face contact is left for
+// narrowphase_clip, ground pairs for narrowphase_ground. An awake partner
+// moving fast or deep in a sleeper wakes it. See docs/decisions/narrowphase.md.
 
 fn shape_of(i: u32) -> Shape {
     let s = state_of(i);
@@ -19,9 +17,8 @@ fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
     return quat_rotate(quat_conj(s.rot), p - s.pos);
 }
 
-// Body i against the ground, within `margin`: a sphere's lowest point, or
-// the box corners within the margin (at most four: the deepest, listed in
-// corner order). The normal points from the body to the ground.
+// Body i against the ground within `margin`, normal from the body down: a
+// sphere's lowest point, or the deepest four box corners within the margin.
 fn ground_manifold(i: u32, margin: f32) -> Manifold {
     let s = state_of(i);
     let p = props_of(i);
@@ -89,9 +86,8 @@ fn wake_check(sleeper: u32, other: u32, gap: f32) {
     }
 }
 
-// Stores manifold m of bodies a and b (b may be GROUND) in pool slot
-// `slot`, its points in the bodies' own frames, and wakes a sleeper that an
-// awake partner presses or hits.
+// Stores manifold m of bodies a and b (b may be GROUND) in `slot`, its points in
+// the bodies' own frames, and wakes a sleeper that an awake partner presses or hits.
 fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
     var kept: ManifoldPoints;
     var deepest = 3.4e38;
@@ -141,8 +137,7 @@ fn new_manifold(a: u32, b: u32, to_clip: bool) -> u32 {
     return slot;
 }
 
-// Appends contact reference r to body i's list (which has room for all of
-// the body's pairs; the cursor counts from 0 after the pair scan).
+// Appends contact reference r to body i's list (room for all its pairs).
 fn list_contact(i: u32, r: u32) {
     let k = pair_meta[i].list_start + atomicAdd(&pair_meta[i].cursor, 1u);
     if (k < arrayLength(&body_pairs)) {
@@ -168,17 +163,15 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     let pr = pairs[p];
-    // ground pairs: narrowphase_ground; bodies joined by a joint do not
-    // collide (the joint holds them together where their shapes meet)
+    // ground pairs: narrowphase_ground; joined bodies do not collide
     if (pr.b == GROUND || joined(pr.a, pr.b)) {
         return;
     }
     let a = shape_of(pr.a);
     let b = shape_of(pr.b);
     let margin = pair_margin(pr.a, pr.b);
-    // Two boxes get their separating axis here; the costly clipping of a face
-    // contact waits for narrowphase_clip. Each step below has one call site, so
-    // the kernel holds one copy (lavapipe's compile time grows with its size).
+    // each step below has one call site, so the kernel holds one copy of it
+    // (lavapipe's compile time grows steeply with a kernel's size)
     let boxes = a.kind == SHAPE_BOX && b.kind == SHAPE_BOX;
     var axis = BoxAxis();
     var m = empty_manifold();
@@ -325,14 +318,12 @@ fn note_long_lists(n: u32) {
     }
 }
 
-// The longest list `sort_short_list` sorts (most bodies of a pile have two
-// to six manifolds; 12 was slower: more work for every list).
+// The longest list sorted in registers (a pile's bodies have 2 to 6 manifolds).
 const SHORT_LIST: u32 = 8u;
 
 // Sorts the `n` (at most SHORT_LIST) contact references from body_pairs[first]
-// by list_order in registers: each reference and key read once, sorted by
-// odd-even transposition (fixed loop counts unroll, every index a constant),
-// written back once; an insertion sort in place read two words a comparison.
+// by list_order in registers: read once, sorted by odd-even transposition
+// (fixed loops unroll, every index a constant), written back once.
 fn sort_short_list(first: u32, n: u32) {
     var refs: array<u32, SHORT_LIST>;
     var keys: array<u32, SHORT_LIST>;
@@ -393,9 +384,8 @@ fn sort_long_list(first: u32, n: u32) {
     if (sorted_to == n) {
         return;
     }
-    // a max-heap of the list (n / 2 sifts), then its largest moved to the
-    // end n - 1 times, each followed by a sift (one loop, one call site:
-    // one copy of sift_down in the kernel)
+    // a max-heap of the list (n / 2 sifts), then its largest moved to the end
+    // n - 1 times, each followed by a sift (one loop: one copy of sift_down)
     let heaped = n / 2u;
     for (var t = 0u; t < heaped + n - 1u; t = t + 1u) {
         var root = 0u;
@@ -414,8 +404,7 @@ fn sort_long_list(first: u32, n: u32) {
     list_trips = list_trips + 1u;
 }
 
-// Moves the reference at place `root` of the heap of `n` from
-// body_pairs[first] down to where its key is no less than its children's.
+// Sifts the reference at `root` of the heap of `n` from body_pairs[first] down.
 fn sift_down(first: u32, root_in: u32, n: u32) {
     var root = root_in;
     let r = body_pairs[first + root];
@@ -445,10 +434,9 @@ fn sift_down(first: u32, root_in: u32, n: u32) {
 }
 
 // Whether body i is a sleeper the step leaves as it is unless something wakes
-// it: SLEEPS (not due to wake), held as integrate holds a sleeper (no
-// displacement or turn, HELD; compared bit for bit), so every pass would copy
-// it; sane (a pose that fails integrate's fault checks is listed, so that they
-// see it); not on a joint (joint_rest writes rest times in place).
+// it: SLEEPS, held as integrate holds a sleeper (no displacement or turn, HELD;
+// bit for bit), so every pass would copy it; sane (else integrate must see its
+// fault); not on a joint (joint_rest writes rest times in place).
 fn sleeps_held(i: u32) -> bool {
     let s = state_of(i);
     let still = all(bitcast<vec3<u32>>(s.disp) == vec3<u32>(0u)) && all(bitcast<vec4<u32>>(s.prev_rot) == bitcast<vec4<u32>>(s.rot));

@@ -209,8 +209,7 @@ fn walk(i: u32) {
     let every = walker.fast && (cube >= f32(params.hash_size) || 2.0 * cube >= f32(cell_start[params.hash_size]));
     cells = select(cells, 1u, every);
     let centre = cell_of(walker.pos);
-    // one loop, one call site: the kernel holds one copy of the cell's walk
-    // (lavapipe's compile time grows steeply with a kernel's size)
+    // one loop, one call site: one copy of the cell's walk in the kernel
     var o = vec3<i32>(0);
     for (var n = 0u; n < cells; n = n + 1u) {
         trips = trips + 1u;
@@ -243,8 +242,7 @@ fn walk(i: u32) {
 fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x < params.body_count) {
         let i = sorted[gid.x];
-        // the grid's arrivals are done with: the body list starts empty
-        // (`listed_body` in bindings.wgsl; contact_lists fills it)
+    // the grid's arrivals are done with: the body list starts empty (`listed_body`)
         sorted[params.body_count + gid.x] = NONE;
         writing = false;
         room_start = gid.x * scratch_room();

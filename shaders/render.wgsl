@@ -12,8 +12,7 @@
 // (near = 1, far = 0, infinite far plane), so a 32-bit float depth buffer
 // keeps its precision from the near plane to the horizon.
 
-// BodyState, quat_rotate, SHAPE_BOX and SHAPE_SPHERE come from common.wgsl
-// and the shared constants, put before this file (src/render.rs).
+// BodyState, quat_rotate and SHAPE_* come from common.wgsl and the shared constants.
 
 // The renderer's constants (208 bytes), written once; `Globals` in src/render.rs.
 struct Globals {
@@ -23,13 +22,11 @@ struct Globals {
     light_view_proj: mat4x4<f32>,
     // xyz = camera position (m)
     eye: vec4<f32>,
-    // xyz = unit vector towards the sun; w = how far a lookup in the shadow
-    // map moves out along the normal (m), against self-shadowing speckle
+    // xyz = unit vector towards the sun; w = shadow lookups' offset along the normal (m)
     light_dir: vec4<f32>,
     // x = ground height (m), y, z = centre of the drawn square (m), w = its half size (m)
     ground: vec4<f32>,
-    // x = minor grid spacing (m), y = major spacing (m), z, w = distances from
-    // the eye where fog starts and where it hides everything (m)
+    // x, y = minor and major grid spacing (m); z, w = where fog starts and is total (m)
     grid: vec4<f32>,
     // rgb = background colour (linear)
     background: vec4<f32>,
@@ -48,8 +45,7 @@ struct RenderBody {
     shape: u32,
 }
 
-// One ball joint (32 bytes); `JointLine` in src/render.rs. A body index of
-// -1 is the world, whose anchor is in world coordinates.
+// One ball joint (32 bytes); `JointLine` in src/render.rs. Body -1 is the world.
 struct JointLine {
     anchor_a: vec3<f32>,
     body_a: i32,
@@ -64,8 +60,7 @@ struct JointLine {
 @group(1) @binding(0) var shadow_map: texture_depth_2d;
 @group(1) @binding(1) var shadow_sampler: sampler_comparison;
 
-// The share of sunlight reaching a point (0 = in shadow), filtered over 3x3
-// texels of the shadow map. Outside the map everything is lit.
+// The share of sunlight reaching a point (0 = shadow), 3x3-filtered; lit outside the map.
 fn sunlit(world_pos: vec3<f32>, n: vec3<f32>) -> f32 {
     // move out along the normal by about a texel, so a surface does not shadow itself
     let p = world_pos + n * globals.light_dir.w;
@@ -153,8 +148,7 @@ fn body_fragment(in: BodyOut) -> @location(0) vec4<f32> {
     // box: distance to the nearest edge is the middle one of the distances to the three faces
     let d = max(in.half_extents - abs(in.local_pos), vec3<f32>(0.0));
     let middle = d.x + d.y + d.z - min(d.x, min(d.y, d.z)) - max(d.x, max(d.y, d.z));
-    // a darker band about a pixel wide along every edge, so faces read apart
-    // (derivatives are taken here, in uniform control flow, for both shapes)
+    // a darker band about a pixel wide along every edge, so faces read apart (uniform control flow)
     let px = fwidth(middle);
     let edge = 1.0 - smoothstep(0.5 * px, 1.5 * px, middle);
     // sphere: two tones by octant of the body frame, so a spin shows
@@ -192,9 +186,8 @@ fn ground_vertex(@builtin(vertex_index) i: u32) -> GroundOut {
     return out;
 }
 
-// Coverage (0..1) of grid lines one pixel wide at integer values of `coord`,
-// antialiased by the screen-space footprint, and faded out where cells
-// shrink to a few pixels, before they alias into moiré.
+// Coverage (0..1) of one-pixel grid lines at integer `coord`, antialiased by the
+// screen-space footprint and faded where cells shrink to a few pixels (moiré).
 fn grid_lines(coord: vec2<f32>) -> f32 {
     let w = max(fwidth(coord), vec2<f32>(1e-6));
     // distance to the nearest line, in pixels
@@ -223,8 +216,7 @@ struct LineOut {
     @location(0) color: vec3<f32>,
 }
 
-// An anchor in world coordinates: a body's local anchor moved by its pose,
-// or a world anchor as it is.
+// An anchor in world coordinates: a body's local anchor moved by its pose, or the world's.
 fn anchor_world(body: i32, anchor: vec3<f32>) -> vec3<f32> {
     if body < 0 {
         return anchor;
@@ -241,9 +233,8 @@ fn centre_of(body: i32, anchor: vec3<f32>) -> vec3<f32> {
     return states[u32(body)].pos;
 }
 
-// Three segments per joint (instance), two vertices each: centre of A to
-// its anchor, anchor A to anchor B (the joint's error, zero when it holds),
-// anchor B to the centre of B.
+// Three segments per joint, two vertices each: centre of A to its anchor, anchor A
+// to anchor B (the joint's error, zero when it holds), anchor B to the centre of B.
 @vertex
 fn joint_vertex(@builtin(vertex_index) v: u32, @builtin(instance_index) j: u32) -> LineOut {
     let jl = joints[j];

@@ -34,9 +34,8 @@ fn end_velocity(i: u32, e: ContactEnd) -> Velocity {
     return pose_velocity(e.disp, e.rot, e.prev_rot);
 }
 
-// ... and before it (integrate's vel0): zero for an end the contacts may
-// not move, as integrate writes for a fixed body or a sleeper (a sleeper
-// the step leaves as it is is not integrated, see `listed_body`).
+// ... and before it (integrate's vel0): zero for an end the contacts may not move,
+// as integrate writes for a fixed body or a sleeper (an unlisted one is not integrated).
 fn end_velocity_before(i: u32, e: ContactEnd) -> Velocity {
     if (!e.moves) {
         return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
@@ -81,9 +80,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     } else if (!ea.moves) {
         split = friction_split(b, 1.0);
     }
-    // summed over the points: the velocity change asked of b (a gets the
-    // opposite), times the inverse masses later, and its moments; the
-    // bounces apart, with the sum of their points' 1 / w
+    // summed over the points: the velocity change asked of b (a gets the opposite;
+    // times the inverse masses later), its moments; the bounces apart, with their 1 / w
     var j = vec3<f32>(0.0);
     var moment_a = vec3<f32>(0.0);
     var moment_b = vec3<f32>(0.0);
@@ -101,8 +99,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         if (dot((eb.pos + rb) - (ea.pos + ra), n) > CONTACT_SLOP) {
             continue;
         }
-        // velocity of a's point relative to b's after the solve, and the
-        // approach speed along n before it
+        // a's point's velocity relative to b's after the solve; the approach before it
         let relative_now = point_velocity(va, ra) - point_velocity(vb, rb);
         let approach = -dot(point_velocity(va0, ra) - point_velocity(vb0, rb), n);
         var impulse = vec3<f32>(0.0);
@@ -122,8 +119,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
             impulse = impulse + t * j;
             acted = true;
         }
-        // restitution of a fast approach (approach < 0: closing), both
-        // speeds along a's push direction -n
+        // restitution of a fast approach (approach < 0: closing), along a's push -n
         let vn = -dot(relative_now, n);
         let target_vn = -e * approach;
         if (approach < -threshold && vn < target_vn) {

@@ -1,13 +1,11 @@
 // Passes "solve_contacts", "solve", "joint_rest" and "solve_joints", run in
 // each substep its share of `iterations` times: the paper's corrective snaps
-// (eqs. 9-10). Contacts are relaxed Jacobi style from state_in:
-// solve_contacts (per manifold) measures a pair's points once and writes what
-// they ask of each body (two EndSnaps); solve (per listed body) sums its
-// manifolds' snaps in pair order, relaxes the sum by c_r (eq. 10) and writes
-// only its own slot of state_out. All of a body's snaps are measured on one
-// pose, so symmetric contacts cancel exactly and no sum depends on thread
-// timing. solve_joints then closes joints Gauss-Seidel style, in place.
-// Why the constants have their values: docs/decisions/contacts.md, joints.md.
+// (eqs. 9-10). Contacts are relaxed Jacobi style from state_in: solve_contacts
+// (per manifold) writes what a pair's points ask of each body (two EndSnaps),
+// and solve (per listed body) sums them in pair order, relaxes the sum by c_r
+// and writes its own slot of state_out. All of a body's snaps are measured on
+// one pose, so symmetric contacts cancel and no sum depends on thread timing.
+// The reasons behind the constants: docs/decisions/contacts.md, joints.md.
 
 // A snap being summed: translation and rotation (radians, world axes).
 struct Snap {
@@ -15,12 +13,10 @@ struct Snap {
     dtheta: vec3<f32>,
 }
 
-// Each point's normal snap closes its depth, shared by the inverse masses (an
-// end that may not move counts 0). Static friction (XPBD) undoes a slide
-// shorter than mu times the substep's summed push; a longer one is left to
-// restitution.wgsl. Points of one face each ask the whole depth, so their sum
-// is scaled down to what moving the bodies apart without turning asks (never
-// up), and their turns are averaged.
+// Each point's normal snap closes its depth, shared by the inverse masses;
+// static friction (XPBD) undoes a slide shorter than mu times the summed push.
+// The points of one face each ask the whole depth, so their sum is scaled down
+// to what moving the bodies apart without turning asks, and their turns averaged.
 
 // Softened shock propagation (after Guendelman et al. 2003): in a contact
 // within 25 degrees of the vertical (|cos| > SHOCK_UP) the lower body counts
@@ -88,8 +84,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         // x: friction's split, y: the normal pushes' (stay_splits)
     let split_a = stay_splits(a, eb.moves);
     let split_b = stay_splits(b, ea.moves);
-        // summed over the points, for a (b gets the opposite): the pushes, their
-        // moments about each centre, the sums of 1 / w
+        // summed over the points for a (b gets the opposite): pushes, moments, 1 / w
     var normal_j = vec3<f32>(0.0);
     var friction_j = vec3<f32>(0.0);
     var moment_a = vec3<f32>(0.0);
@@ -98,8 +93,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     var friction_inv_w = 0.0;
     var points = 0u;
     var pressed = 0u;
-        // depth summed: what pushes out old overlap deeper than SETTLE_SPEED
-        // allows, what pushes out shallower old overlap, and all of it
+        // depths summed: old overlap that settles, old overlap that supports, all
     var old_depth = 0.0;
     var shallow_depth = 0.0;
     var all_depth = 0.0;
@@ -204,14 +198,12 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     var flags = 0u;
     let first = pair_meta[i].list_start;
     let end = first + pair_meta[i].contacts;
-    // the snaps' settling parts, apart (not for a jointed body: its joints
-    // measure old gaps at the previous poses, which settling moves)
+    // the snaps' settling and supporting parts, apart (not for a jointed body:
+    // its joints measure old gaps at the previous poses, which settling moves)
     var settle = Snap(vec3<f32>(0.0), vec3<f32>(0.0));
     var settling = 0u;
-    // the parts pushing out shallower old overlap (SUPPORT_SPEED), likewise
     var support_dx = vec3<f32>(0.0);
     let jointed = is_jointed(i);
-    // the body's manifolds in pair order (contact_lists)
     for (var e = first; e < end; e = e + 1u) {
         let snap = snap_of(body_pairs[e]);
         let settles = select(snap.flags >> SETTLE_SHIFT, 0u, jointed);
@@ -232,9 +224,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         touching = touching + snap.count;
         flags = flags | snap.flags;
     }
-    // Summed turns overshoot (each snap turns the body as if alone), so a
-    // partner's points share one turn and the partners' turns are averaged
-    // (mass splitting for the inertia; translations are scaled per partner).
+    // summed turns overshoot, so a partner's points share one turn and the
+    // partners' turns are averaged (translations are scaled per partner)
     let split = 1.0 / f32(max(touching, 1u));
     // a snap moves the displacement with the pose: the velocity changes by
     // dx / h, as Verlet's moving x_n while x_(n-1) stays does
@@ -252,10 +243,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     s.disp = s.disp + rise * min(lift, room);
     s.pos_low = (s.pos_low & ~HELD) | select(0u, HELD, (flags & SNAP_PRESSED) != 0u);
     s.rot = quat_add_rotation(s.rot, acc.dtheta * (params.relaxation * split));
-    // Settling: old overlap deeper than SETTLE_SPEED allows is pushed out by
-    // moving the pose and the previous pose together, by the mean of those
-    // parts, so several partners' pushes do not add up to velocity. A settling
-    // body is not at rest, though its velocity may be nil.
+    // Settling (SETTLE_SPEED): both poses move by the mean of the settling parts.
+    // A settling body is not at rest, though its velocity may be nil.
     if (settling > 0u) {
         s.rest_time = 0.0;
         let share = params.relaxation / f32(settling);
@@ -288,9 +277,8 @@ fn close_joint(j: JointRef) {
     let rb = quat_rotate(sb.rot, j.local_partner);
     let gap = select(j.local_partner, sb.pos + rb, joined) - (sa.pos + ra);
     let dist = length(gap);
-    // the gap at the previous poses closes at no more than
-    // MAX_DEPENETRATION_SPEED, as overlap does (a full snap becomes velocity);
-    // what this substep opened closes whole
+    // the gap at the previous poses closes at no more than MAX_DEPENETRATION_SPEED
+    // (a full snap becomes velocity); what this substep opened closes whole
     let moved_a = sa.disp + (ra - quat_rotate(sa.prev_rot, j.local_self));
     let moved_b = select(vec3<f32>(0.0), sb.disp + (rb - quat_rotate(sb.prev_rot, j.local_partner)), joined);
     let before = length(gap - (moved_b - moved_a));
@@ -371,10 +359,9 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (params.sleep_after > 0.0 && out_state(joint_refs[first].body).rest_time >= params.sleep_after) {
         return;
     }
-    // the sweeps out and back as one loop counted by the path's own length (a
-    // loop bounded by a uniform alone is recompiled by lavapipe every
-    // dispatch): params.joint_sweeps sweeps, or fewer within the path's budget
-    // of closes (CUT_PATH_CLOSES for a path cut from a large island)
+    // the sweeps out and back as one loop counted by the path's length (a loop
+    // bounded by a uniform alone is recompiled by lavapipe every dispatch), up to
+    // params.joint_sweeps within the path's budget of closes (CUT_PATH_CLOSES)
     let n = end - first;
     let closes = joint_start[params.body_count + params.island_count + 3u + params.path_count + path];
     let sweeps = max(min(params.joint_sweeps, closes / (2u * n)), 1u);
