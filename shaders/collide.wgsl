@@ -1,14 +1,12 @@
 // Contact manifolds between boxes and spheres: the twin of
 // src/reference/collide.rs, step for step (its box_box is box_box_axis, then
-// box_box_edge or box_box_face here, which the narrowphase runs in two passes). A manifold's normal points from
-// the first shape to the second; its points come in pairs (on_a, on_b) whose
-// separation dot(on_b - on_a, n) is negative where the shapes overlap.
+// box_box_edge or box_box_face here). A manifold's normal points from the
+// first shape to the second; dot(on_b - on_a, n) < 0 where the shapes overlap.
 
 
 // An edge axis must beat the best face axis by this much (m) to be chosen.
 const EDGE_BIAS: f32 = 0.005;
-// The second box's face must beat the first's by this much (m) to be the
-// reference face (see the reference's FACE_BIAS).
+// The second box's face must beat the first's by this much (m) to be the reference face.
 const FACE_BIAS: f32 = 0.0025;
 
 struct Shape {
@@ -93,8 +91,7 @@ fn box_sphere(cb: vec3<f32>, rot: vec4<f32>, h: vec3<f32>, cs: vec3<f32>, r: f32
 fn flip_manifold(m_in: Manifold) -> Manifold {
     var m = m_in;
     m.normal = -m_in.normal;
-    // every point, used or not: a loop of fixed length indexes its arrays
-    // with constants once unrolled
+    // every point, used or not: a fixed-length loop indexes by constants once unrolled
     for (var k = 0u; k < MAX_POINTS; k = k + 1u) {
         m.on_a[k] = m_in.on_b[k];
         m.on_b[k] = m_in.on_a[k];
@@ -154,9 +151,8 @@ fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
     return a.x * b.y - a.y * b.x;
 }
 
-// The separating-axis test of two boxes within `margin`: the axis of
-// least separation, a face axis (a's faces 0..3, b's 3..6; b's only if it
-// beats a's by FACE_BIAS) unless an edge axis beats it by EDGE_BIAS. Its normal points from a to b.
+// The separating-axis test of two boxes within `margin`: the axis of least separation,
+// a face axis (a's 0..3, b's 3..6) unless an edge axis beats it by EDGE_BIAS; a to b.
 struct BoxAxis {
     kind: u32, // AXIS_*
     normal: vec3<f32>,
@@ -170,10 +166,9 @@ const AXIS_FACE: u32 = 1u;
 const AXIS_EDGE: u32 = 2u;
 
 fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>, margin: f32) -> BoxAxis {
-    // Everything in a's frame: column j of r is b's axis j, t is b's centre.
-    // All 15 axes are tested without an early exit and without indexing an
-    // array: lanes packed into one vector run the same code whatever their
-    // pair, and most candidate pairs touch.
+    // In a's frame (column j of r is b's axis j, t is b's centre), all 15 axes
+    // with no early exit and no array indexing: a vector's lanes run the same
+    // code whatever their pair, and most candidate pairs touch.
     let axes_a = box_axes(qa);
     let axes_b = box_axes(qb);
     let ma = mat3x3<f32>(axes_a[0], axes_a[1], axes_a[2]);
@@ -185,8 +180,7 @@ fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let sep_a = abs(t) - ha - ar * hb;
     let s_b = t * r;
     let sep_b = abs(s_b) - ha * ar - hb;
-    // the best face of each (the first of equals); b's is the reference
-    // face only if it beats a's by FACE_BIAS
+    // the best face of each (the first of equals); b's must beat a's by FACE_BIAS
     let a_sep = max(max(sep_a.x, sep_a.y), sep_a.z);
     let b_sep = max(max(sep_b.x, sep_b.y), sep_b.z);
     let a_face = select(select(2u, 1u, sep_a.y >= sep_a.z), 0u, sep_a.x >= sep_a.y && sep_a.x >= sep_a.z);
@@ -199,8 +193,7 @@ fn box_box_axis(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
                                        select(axes_b[2], axes_a[2], best_face < 3u)), best_face % 3u);
     let best_face_n = select(face_axis, -face_axis, face_s < 0.0);
 
-    // edge axes a_i x b_j, in a's frame; near-parallel edges are left to
-    // the face axes
+    // edge axes a_i x b_j, in a's frame; near-parallel edges are left to the faces
     var best_edge_sep = -3.4e38;
     var best_edge_l = vec3<f32>(0.0, 1.0, 0.0);
     var best_edge = 0u;
@@ -238,9 +231,8 @@ fn box_box_edge(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let n = axis.normal;
     let edge_i = axis.edge_i;
     let edge_j = axis.edge_j;
-    // the edge of a farthest along n, the edge of b farthest along -n (the
-    // axes picked by select, not by an index: an array indexed by a value
-    // that differs per lane is slow to run and to compile on lavapipe)
+    // the edge of a farthest along n, the edge of b farthest along -n (axes
+    // picked by select: a per-lane array index is slow on lavapipe)
     var pa = ca;
     var pb = cb;
     for (var k = 0u; k < 3u; k = k + 1u) {
@@ -261,11 +253,9 @@ fn box_box_edge(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     return m;
 }
 
-// The manifold of a face contact (an AXIS_FACE of normal n, reference face
-// best_face): the incident face of the other box clipped against the
-// reference face's sides, its points within the margin, reduced to four.
-// The clipping runs in the reference face's plane; a point's height above
-// that face follows from the incident face's plane.
+// The manifold of a face contact (AXIS_FACE, normal n, reference face best_face):
+// the other box's incident face clipped against the reference face's sides in its
+// plane, the points within the margin, reduced to four.
 fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: vec4<f32>, hb: vec3<f32>,
                 n: vec3<f32>, best_face: u32, margin: f32) -> Manifold {
     var m = empty_manifold();
@@ -283,8 +273,7 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let inc_axes = mat3x3<f32>(select(axes_b[0], axes_a[0], flipped), select(axes_b[1], axes_a[1], flipped),
                                select(axes_b[2], axes_a[2], flipped));
     let ref_n = select(n, -n, flipped);
-    // incident face: the face of the incident box most anti-parallel to ref_n
-    // (the first of equals)
+    // incident face: the incident box's face most anti-parallel to ref_n (first of equals)
     let along = abs(ref_n * inc_axes);
     let inc_face = select(select(2u, 1u, along.y >= along.z), 0u, along.x >= along.y && along.x >= along.z);
     let inc_axis = column(inc_axes, inc_face);
@@ -302,26 +291,21 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let c = to_face * (inc_centre - ref_centre);
     let du = (to_face * eu).xy;
     let dv = (to_face * ev).xy;
-    // the incident face's corners, x and y four to a vector, and its edges
-    // from each corner to the next
+    // the incident face's corners, x and y four to a vector, and its edges corner to corner
     let px = c.x + vec4<f32>(du.x, -du.x, -du.x, du.x) + vec4<f32>(dv.x, dv.x, -dv.x, -dv.x);
     let py = c.y + vec4<f32>(du.y, -du.y, -du.y, du.y) + vec4<f32>(dv.y, dv.y, -dv.y, -dv.y);
     let ex = px.yzwx - px;
     let ey = py.yzwx - py;
-    // height of the incident face above the reference face at (x, y):
-    // c.z + slope . ((x, y) - c.xy) (|nf.z| >= 1/sqrt(3): the most parallel axis)
+    // the incident face's height above the reference face at (x, y): c.z + slope .
+    // ((x, y) - c.xy); |nf.z| >= 1/sqrt(3), nf being the most parallel axis
     let nf = to_face * inc_axis;
     let slope = -nf.xy / nf.z;
 
-    // The corners of the incident face's part within the reference face
-    // (|x| <= half.x, |y| <= half.y), found without clipping in arrays
-    // (lavapipe keeps dynamically indexed arrays in memory), as twelve
-    // candidates in three groups of four: where each edge enters the
-    // reference face (its start when that lies on it) and where it leaves
-    // it before its end, from the part t0..t1 of the edge within both slabs
-    // (Liang-Barsky); then the reference face's corners strictly inside the
-    // incident face (on the inner side of its four edges, which the face's
-    // winding cross2(du, dv) tells).
+    // The corners of the incident face's part within the reference face, found
+    // without clipping in arrays (lavapipe keeps dynamically indexed arrays in
+    // memory), as twelve candidates in three groups of four: where each edge
+    // enters and leaves the reference face (Liang-Barsky on the two slabs),
+    // then the reference face's corners strictly inside the incident face.
     let half = vec2<f32>(ref_h[side_u], ref_h[side_v]);
     let span_x = slab_span(px, ex, half.x);
     let span_y = slab_span(py, ey, half.y);
@@ -338,10 +322,8 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     let g1 = candidates(px + t1 * ex, py + t1 * ey, leaves, c, slope, margin);
     let g2 = candidates(rx, ry, inside, c, slope, margin);
 
-    // those within the margin of the reference face (`kept`), reduced to
-    // four: the deepest, the farthest from it, the largest triangle, the
-    // largest area added outside that triangle (the first of equals each,
-    // in candidate order; NONE when none is kept)
+    // those within the margin (`kept`), reduced to four: the deepest, the farthest from
+    // it, the largest triangle, the largest area added (first of equals; NONE if none)
     let c0 = best_candidate(-g0.z, -g1.z, -g2.z, g0, g1, g2);
     let p0 = candidate_at(g0, g1, g2, c0).xy;
     let c1 = best_candidate(distance2_to(g0, p0), distance2_to(g1, p0), distance2_to(g2, p0), g0, g1, g2);
@@ -373,9 +355,8 @@ fn box_box_face(ca: vec3<f32>, qa: vec4<f32>, ha: vec3<f32>, cb: vec3<f32>, qb: 
     return m;
 }
 
-// The parameters t at which edges p + t e (four at once, along one axis)
-// enter and leave the slab |x| <= h; an edge parallel to it spans
-// everything or nothing.
+// The parameters t at which edges p + t e (four at once) enter and leave the slab
+// |x| <= h; an edge parallel to it spans everything or nothing.
 struct SlabSpan {
     enter: vec4<f32>,
     leave: vec4<f32>,
@@ -397,9 +378,8 @@ fn inside_face(x: f32, y: f32, px: vec4<f32>, py: vec4<f32>, ex: vec4<f32>, ey: 
     return all((ex * (y - py) - ey * (x - px)) * winding > vec4<f32>(0.0));
 }
 
-// Four candidate corners of a face contact's points in the reference
-// face's plane, their heights above it, and which are kept: corners of
-// the overlap within the margin.
+// Four candidate points of a face contact in the reference face's plane, their
+// heights above it, and which are kept (corners of the overlap within the margin).
 struct Candidates {
     x: vec4<f32>,
     y: vec4<f32>,
@@ -421,8 +401,7 @@ fn candidate_at(g0: Candidates, g1: Candidates, g2: Candidates, k: u32) -> vec3<
     return vec3<f32>(x[lane], y[lane], z[lane]);
 }
 
-// The kept candidate of highest score (scores by group), the first of
-// equals; NONE when none is kept.
+// The kept candidate of highest score (scores by group), the first of equals; or NONE.
 fn best_candidate(s0: vec4<f32>, s1: vec4<f32>, s2: vec4<f32>, g0: Candidates, g1: Candidates, g2: Candidates) -> u32 {
     var score = -3.4e38;
     var best = NONE;
@@ -450,16 +429,14 @@ fn cross2_to(g: Candidates, o: vec2<f32>, d: vec2<f32>) -> vec4<f32> {
     return d.x * (g.y - o.y) - d.y * (g.x - o.x);
 }
 
-// Area (twice) that four candidates add outside the triangle p0 p1 p2 of
-// winding `side`: the most by which one lies outside any of its edges.
+// Twice the area four candidates add outside triangle p0 p1 p2 (winding `side`).
 fn area_added(g: Candidates, p0: vec2<f32>, p1: vec2<f32>, p2: vec2<f32>, side: f32) -> vec4<f32> {
     return max(max(-side * cross2_to(g, p0, p1 - p0), -side * cross2_to(g, p1, p2 - p1)), -side * cross2_to(g, p2, p0 - p2));
 }
 
 // The manifold of a pair of which at least one is a sphere. A box and a
 // sphere are measured box first, in one call for either order (one copy of
-// box_sphere in the kernel: lavapipe's compile time grows steeply with a
-// kernel's size), and flipped back when the sphere came first.
+// box_sphere in the kernel), and flipped back when the sphere came first.
 fn collide_with_sphere(a: Shape, b: Shape, margin: f32) -> Manifold {
     if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_SPHERE) {
         return sphere_sphere(a.centre, a.half.x, b.centre, b.half.x, margin);

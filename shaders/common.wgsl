@@ -1,26 +1,15 @@
 // Types and maths that bind nothing, shared by every compute pass and the
-// renderer: the body layout, the per-step parameters, the contact records
-// and the quaternion helpers. Every struct here has a #[repr(C)] twin in
-// src/gpu/types.rs, checked member by member by tests/gpu/layouts.rs. The
-// constants shared with Rust (NONE, GROUND, WORLD, HELD, MAX_POINTS,
-// SHAPE_*, FLAG_FIXED, GRID_BODY, LARGE_BODY, WORKGROUP, SCAN_BLOCK, the
-// fault codes and limits) are not written here: src/gpu/shaders.rs writes
-// them from the Rust values, before this file, in every module. Helpers
-// that read the step's bindings live in bindings.wgsl.
+// renderer: the body layout, the per-step parameters, the contact records and
+// the quaternion helpers. Every struct has a #[repr(C)] twin in
+// src/gpu/types.rs (tests/gpu/layouts.rs checks them). The constants shared
+// with Rust (NONE, GROUND, WORKGROUP, the fault codes and limits, ...) are
+// written before this file from the Rust values (src/gpu/shaders.rs).
 
-// Pose of one body: what swaps between the two state buffers every pass.
-// 64 bytes. Quaternions are (x, y, z, w).
-//
-// The translation is kept as the displacement x_n - x_(n-1) rather than the
-// previous position: the same Verlet algebra, but the velocity disp / h no
-// longer comes from the difference of two large numbers (in f32 a position
-// near 100 m is held to 8e-6 m, while gravity adds g h^2 = 3e-4 m per
-// substep: a projectile 100 m up strayed 15 cm from its parabola in 2 s).
-// Every snap that moves pos moves disp with it, as moving pos while the
-// previous position stayed did. `pos_low` keeps what rounding dropped from
-// pos when integrate added the displacement (see `pos_remainder`): at 1 km
-// the f32 grid is 6e-5 m, and a steady horizontal displacement rounded the
-// same way every substep (21 mm in 2 s at 8 substeps).
+// Pose of one body: what swaps between the two state buffers every pass. 64
+// bytes; quaternions are (x, y, z, w). The displacement x_n - x_(n-1) is kept
+// instead of the previous position, so the velocity disp / h is not the
+// difference of two large f32 numbers, and `pos_low` keeps what rounding
+// dropped from pos (docs/decisions/integration.md).
 struct BodyState {
     pos: vec3<f32>,      // centre of mass (m)
     rest_time: f32,      // seconds at rest (see `asleep`)
@@ -38,25 +27,22 @@ fn remainder_unit(x: vec3<f32>) -> vec3<f32> {
     return bitcast<vec3<f32>>(exponent) * 2.3283064e-10; // 2^-32 = 2^-23 / 512
 }
 
-// What rounding dropped from pos.xyz (m): the true centre is pos + this.
-// Each coordinate is a signed 10-bit multiple of remainder_unit (bits 0-9 x,
-// 10-19 y, 20-29 z, offset by 512), so it holds about 1/1000 of a spacing.
+// What rounding dropped from pos.xyz (m): the true centre is pos + this. Each
+// coordinate a signed 10-bit multiple of remainder_unit (bits 0-9 x, 10-19 y, 20-29 z).
 fn pos_remainder(s: BodyState) -> vec3<f32> {
     let q = (vec3<u32>(s.pos_low) >> vec3<u32>(0u, 10u, 20u)) & vec3<u32>(0x3ffu);
     return (vec3<f32>(q) - 512.0) * remainder_unit(s.pos);
 }
 
-// pos_low for a remainder r (m) of the position x, with the HELD and WAKES
-// bits of `flags`.
+// pos_low for a remainder r (m) of the position x, with `flags`' HELD and WAKES bits.
 fn pack_remainder(r: vec3<f32>, x: vec3<f32>, flags: u32) -> u32 {
     let q = vec3<u32>(vec3<i32>(clamp(round(r / remainder_unit(x)), vec3<f32>(-511.0), vec3<f32>(511.0))) + 512);
     return q.x | (q.y << 10u) | (q.z << 20u) | (flags & (HELD | WAKES));
 }
 
 // What rarely changes: shape, mass and material. 64 bytes. What a contact
-// reads of a body (the contact passes' `contact_end`) lies in the second
-// and third 16 bytes: its inverse inertia and mass, then its material,
-// shape and flags.
+// reads of a body (`contact_end`) lies in two of its four words: inverse
+// inertia and mass, then material, shape and flags.
 struct BodyProps {
     half_extents: vec4<f32>, // box: xyz half extents; sphere: radius in x; w = bounding radius
     inv_inertia: vec4<f32>,  // xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg)
@@ -70,8 +56,7 @@ struct BodyProps {
     _pad1: u32,
 }
 
-// Velocities just after integration, before any constraint: the approach
-// velocities that restitution reflects. 32 bytes.
+// Velocities just after integration: the approach velocities restitution reflects. 32 bytes.
 struct Velocity {
     linear: vec4<f32>,  // m/s
     angular: vec4<f32>, // rad/s, world frame
@@ -107,17 +92,14 @@ struct Params {
     _pad1: u32,
 }
 
-// A candidate pair found by the broadphase (pairs.wgsl): body a owns it; b
-// is another body or GROUND. 8 bytes.
+// A candidate pair (pairs.wgsl): body a owns it; b is a body or GROUND. 8 bytes.
 struct Pair {
     a: u32,
     b: u32,
 }
 
-// One contact point of a pair: the point on each body in that body's own
-// frame (the ground's in world coordinates), and the normal push summed over
-// this substep's sweeps (m): its friction budget, written by the manifold's
-// solve_contacts invocation and emptied by restitution_contacts. 32 bytes.
+// One contact point: the point on each body in its own frame (the ground's in world
+// coordinates), and its friction budget: the normal push summed this substep (m). 32 bytes.
 struct ContactPoint {
     local_a: vec3<f32>,
     pushed: f32,
@@ -125,10 +107,8 @@ struct ContactPoint {
     _pad0: f32,
 }
 
-// A pair's contact manifold, found once per step: up to MAX_POINTS points
-// sharing one world normal, pointing from a to b (GROUND or a body). Its
-// header (32 bytes) here; its points at the same slot of the pool's point
-// parts (ManifoldPoints, see `point_of` in bindings.wgsl).
+// A pair's contact manifold, found once a step: up to MAX_POINTS points sharing one
+// normal, from a to b. Its 32-byte header; the points lie in the pool's parts (`point_of`).
 struct ContactManifold {
     normal: vec3<f32>,
     count: u32,
@@ -144,17 +124,11 @@ struct ManifoldPoints {
 }
 
 // What one manifold asks of one of its bodies in a sweep, summed over its
-// points (solve_contacts, restitution_contacts): a move (m, or m/s in
-// restitution) and a turn (radians, or rad/s), world axes; `count`: 1 if
-// the manifold snapped the body (solve) or the points that acted
-// (restitution); `flags`: SNAP_PRESSED if a point has pushed in this
-// substep, above SETTLE_SHIFT the share of the move and turn that pushes
-// out old overlap deeper than SETTLE_SPEED allows, in 1/SETTLE_ONE, and
-// above SUPPORT_SHIFT (15 bits) the share of the move that pushes out
-// shallower old overlap, in 1/SUPPORT_ONE (solve only; see solve.wgsl). A
-// manifold's two, a's then b's, sit at 2 x its slot: a body reads its at
-// its contact reference (contact_ref; see `snap_of` in bindings.wgsl).
-// 32 bytes.
+// points: a move (m; m/s in restitution) and a turn (rad; rad/s), world axes;
+// `count`: 1 if it snapped the body (solve) or the points that acted
+// (restitution); `flags`: SNAP_PRESSED, the settling share above SETTLE_SHIFT
+// and the support share above SUPPORT_SHIFT (solve.wgsl). A manifold's two,
+// a's then b's, sit at 2 x its slot (`snap_of`). 32 bytes.
 struct EndSnap {
     dx: vec3<f32>,
     count: u32,
@@ -169,21 +143,12 @@ const SUPPORT_SHIFT: u32 = 1u;
 const SUPPORT_MASK: u32 = 0x7fffu;
 const SUPPORT_ONE: f32 = 32767.0;
 
-// Per body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl):
-// how many pairs it owns (see pairs.wgsl) and is in, the prefix sums of
-// both, the cursor its incoming pairs are counted and listed by, whether
-// the narrowphase found it woken (WOKEN_NOW; integrate moves it to the
-// pose's WAKES bit), whether contacts can move it this step (MOVES, SLEEPS,
-// STAYS_FIXED), how many of its
-// pairs have a manifold (contact_lists: its list then starts with their
-// contact references, see `contact_ref`), and its bounds: the half extents
-// of its world box grown by its reach (how far any point of it may move
-// this step, m: the centre's move and `spin`, what its turn adds; see
-// grid.wgsl's reach_of and spin_reach_of),
-// how many of its manifolds are with an end that stays and what its normal
-// pushes against them count its inverse mass (contact_lists; the splits,
-// see bindings.wgsl's friction_split and solve.wgsl's stay_splits). The
-// entry after the last body holds the totals. 64 bytes.
+// Per-body pair bookkeeping, rebuilt every step (grid_count, pairs.wgsl,
+// contact_lists): the pairs it owns and is in and their prefix sums, the
+// cursor its incoming pairs are counted and listed by, WOKEN_NOW, MOVES /
+// SLEEPS / STAYS_FIXED, its manifolds, its bounds grown by its reach (`spin`:
+// the turn's part), and the splits against ends that stay (`held`,
+// `normal_split`). The entry after the last body holds the totals. 64 bytes.
 struct PairMeta {
     owned: u32,
     total: u32,
@@ -202,11 +167,8 @@ struct PairMeta {
 }
 
 // A grid body's bounds in the grid's order, as the pair walks read them
-// (grid_sort writes them; pairs.wgsl): its centre, its bounds (pair_meta's
-// bound and extent) and its index with pair_meta's moves in the top two
-// bits. One record a candidate, the bodies of a cell side by side: the
-// walks read their candidates' bounds from state_in and pair_meta before,
-// two records of 64 bytes apart. 32 bytes.
+// (grid_sort): centre, bound, extent, and its index with pair_meta's moves in
+// the top bits; one 32-byte record a candidate, a cell's side by side.
 struct CellBound {
     pos: vec3<f32>,
     bound: f32,
@@ -214,36 +176,28 @@ struct CellBound {
     body: u32,
 }
 
-// pair_meta[i].moves (grid_count): contacts can move the body this step
-// (awake, or asleep but woken by the last step's narrowphase); it sleeps
-// (and its pairs are found by the bodies that move: pairs.wgsl); it is
-// fixed.
+// pair_meta[i].moves: contacts can move the body this step (awake, or woken by
+// the last step's narrowphase); it sleeps (the movers find its pairs); it is fixed.
 const MOVES: u32 = 1u;
 const SLEEPS: u32 = 2u;
 const STAYS_FIXED: u32 = 0u;
 
-// pair_meta[i].woken's WOKEN_NOW (shared with Rust, whose snapshots keep
-// it): set by the narrowphase when an awake partner wakes a sleeper; moved
-// by integrate to the pose's WAKES bit (pos_low bit 30, shared with Rust),
-// which wakes the body one step later, once the pair list holds all of its
-// pairs again.
+// pair_meta[i].woken's WOKEN_NOW (shared with Rust): set by the narrowphase
+// when an awake partner wakes a sleeper; integrate moves it to the pose's
+// WAKES bit (pos_low bit 30), which wakes the body a step later.
 
-// A body's reference to one of its manifolds, as contact_lists leaves it in
-// the body's list: the manifold's index and which end of it the body is.
+// A body's reference to one of its manifolds: the manifold's index and which end it is.
 fn contact_ref(manifold: u32, is_b: bool) -> u32 {
     return 2u * manifold + u32(is_b);
 }
 
-// MAX_DEPENETRATION_SPEED (shared with Rust, src/world.rs): the fastest
-// (m/s) the solve pushes apart bodies that already overlapped at their
-// previous poses.
+// MAX_DEPENETRATION_SPEED (shared with Rust): the fastest (m/s) the solve
+// pushes apart bodies that already overlapped at their previous poses.
 
-// Points closer than this (m) still count as touching when restitution is
-// decided after the solve.
+// Points closer than this (m) still touch when restitution is decided after the solve.
 const CONTACT_SLOP: f32 = 0.002;
-// One end of a ball joint as the body at that end sees it: its anchor in its
-// own frame, the partner's anchor in the partner's frame (world coordinates
-// when the partner is WORLD). 32 bytes.
+// One end of a ball joint as the body at that end sees it: both anchors, each in its
+// body's frame (the world's in world coordinates). 32 bytes.
 struct JointRef {
     local_self: vec3<f32>,
     partner: u32,
@@ -269,9 +223,8 @@ fn quat_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
 }
 
 // atan(x) for 0 <= x, without the builtin: Vulkan lets atan2, sin and cos be
-// off by 2^-11 absolute, which a spinning body integrates into drift. Two
-// half-angle reductions bring x under 0.27, where the odd series to x^11 is
-// good to about 1e-8.
+// off by 2^-11, which a spinning body integrates into drift. Two half-angle
+// reductions bring x under 0.27, where the series to x^11 is good to 1e-8.
 fn atan_precise(x_in: f32) -> f32 {
     var x = x_in;
     var scale = 1.0;
@@ -296,16 +249,14 @@ fn quat_to_rotvec(q_in: vec4<f32>) -> vec3<f32> {
     if (s < 1e-12) {
         return 2.0 * q.xyz;
     }
-    // atan(s / w), or pi/2 - atan(w / s) past 45 degrees: one call of
-    // atan_precise, so one copy of it where this is inlined
+    // atan(s / w), or pi/2 - atan(w / s) past 45 degrees: one inlined atan_precise
     let small = s <= q.w;
     let a = atan_precise(select(q.w / s, s / q.w, small));
     let half_angle = select(1.5707964 - a, a, small);
     return q.xyz * (2.0 * half_angle / s);
 }
 
-// Unit quaternion of a rotation vector; a series for the small angles of one
-// step (see atan_precise for why not the builtins).
+// Unit quaternion of a rotation vector; a series for one step's small angles (atan_precise).
 fn quat_from_rotvec(v: vec3<f32>) -> vec4<f32> {
     let angle = length(v);
     let h = 0.5 * angle;
@@ -352,9 +303,8 @@ fn quat_to_mat(q: vec4<f32>) -> mat3x3<f32> {
                        vec3<f32>(xz + wy, yz - wx, 1.0 - xx - yy));
 }
 
-// World-frame inverse inertia as a matrix, from the rotation's matrix r:
-// R diag(inv_i) R^T. Made once for an end of a manifold, it spares each of
-// the manifold's pushes the two rotations inv_inertia_world makes.
+// World-frame inverse inertia as a matrix, R diag(inv_i) R^T from the rotation's
+// matrix r: made once for a manifold's end, it spares each push two rotations.
 fn world_inv_inertia(r: mat3x3<f32>, inv_i: vec3<f32>) -> mat3x3<f32> {
     return mat3x3<f32>(r[0] * inv_i.x, r[1] * inv_i.y, r[2] * inv_i.z) * transpose(r);
 }
@@ -375,8 +325,7 @@ fn effective_inv_mass(p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>
     return p.inv_inertia.w + dot(rn, inv_inertia_world(rot, p.inv_inertia.xyz, rn));
 }
 
-// One body of a contact manifold as the contact passes see it: its poses
-// (the current one and how it got there from the previous),
+// One body of a contact manifold as the contact passes see it: its poses,
 // masses and material; the ground is an end at the origin with no mass.
 struct ContactEnd {
     pos: vec3<f32>,
@@ -393,12 +342,10 @@ struct ContactEnd {
     radius: f32,            // a sphere's radius (m); 0 for a box or the ground
 }
 
-// The point of an end a contact of normal `toward` (pointing from the end
-// to its partner) measures, in the end's frame: the stored point, or for a
-// sphere the point of its surface that faces the partner now. A sphere's
-// material point found at the step's start turns away with its spin (a
-// ball rolling at 13 m/s turns 0.7 rad a step), and one measured there
-// read the ball as above the ground while it sank through it.
+// The point of an end a contact of normal `toward` (from the end to its
+// partner) measures, in the end's frame: the stored point, or for a sphere the
+// point of its surface that faces the partner now (a fast roll turns the
+// stored material point away, and the ball sank through the ground).
 fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
     if (e.radius > 0.0) {
         return (toward * e.radius) * e.rot_m; // R^T (toward r)
@@ -406,8 +353,7 @@ fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
     return stored;
 }
 
-// Generalised inverse mass of an end for a unit push along dir at offset r;
-// 0 for an end the contacts may not move (the ground, fixed, asleep).
+// Generalised inverse mass of an end along dir at offset r; 0 for an end that stays.
 fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
     if (!e.moves) {
         return 0.0;
@@ -416,9 +362,8 @@ fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
     return e.inv_inertia.w + dot(rn, e.inv_i_world * rn);
 }
 
-// What a summed impulse-like vector j (through points at summed moments
-// `moment` = sum of r x j) asks of an end: its inverse mass times j, its
-// world inverse inertia times the moment (nothing for an end that stays).
+// What a summed impulse-like j (moments `moment` = sum of r x j) asks of an end:
+// inverse mass times j, world inverse inertia times the moment (nothing if it stays).
 fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, flags: u32) -> EndSnap {
     if (!e.moves) {
         return EndSnap(vec3<f32>(0.0), 0u, vec3<f32>(0.0), flags);
@@ -426,9 +371,8 @@ fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, flags: u
     return EndSnap(j * e.inv_inertia.w, count, e.inv_i_world * moment, flags);
 }
 
-// Restitution and friction of a contact: the larger restitution and the
-// geometric mean of the frictions (Box2D's rule); the ground's material is
-// settings.restitution and settings.friction.
+// A contact's material: the larger restitution and the geometric mean of the
+// frictions (Box2D's rule); the ground's is settings.restitution and .friction.
 fn combined_restitution(a: ContactEnd, b: ContactEnd) -> f32 {
     return max(a.restitution, b.restitution);
 }

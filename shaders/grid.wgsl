@@ -1,53 +1,30 @@
-// Broadphase: a uniform grid rebuilt every step by counting sort into
-// preallocated buffers. Cells are hashed into hash_size buckets, so the grid
-// is unbounded; a bucket may hold bodies of several cells, which the
-// narrowphase tells apart by each body's own cell.
-//
-//   grid_count        bodies:  count[bucket of body]++
-//   scan_blocks       buckets: exclusive prefix sum within blocks of SCAN_SPAN
-//   scan_sums         one workgroup: prefix sum of the block totals
-//   scan_add          buckets: add block offsets -> cell_start (the grid's
-//                     alone: pairs_write adds the pairs' own)
-//   grid_scatter      bodies:  arrivals[cell_end - count--] = body (the
-//                     arrivals: sorted's second half, which pairs_count
-//                     empties for the body list after the sort)
-//   grid_sort         bodies:  each body's place in its bucket by the low x
-//                     side of its bounds, then index, counted over the
-//                     bucket's arrivals (the pair walks stop early);
-//                     sorted[place] = body, and its bounds there (cell_bounds)
-//
-// The scatter counts each bucket back down to 0, so the counts are 0 again
-// for the next step without a pass to clear them (a new buffer is zeroed).
-//
+// Broadphase: a uniform grid rebuilt every step by counting sort. Cells are
+// hashed into hash_size buckets, so the grid is unbounded; a bucket may hold
+// several cells, told apart by each body's own cell.
+//   grid_count    bodies:  count[bucket]++; what the pair walks read (PairMeta)
+//   scan_blocks   buckets: exclusive prefix sum within blocks of SCAN_SPAN
+//   scan_sums     one workgroup: prefix sum of the block totals
+//   scan_add      buckets: add block offsets -> cell_start
+//   grid_scatter  bodies:  arrivals[cell_end - count--] = body (counting each
+//                 bucket back to 0 for the next step: no clearing pass)
+//   grid_sort     bodies:  place in the bucket by the box's low x, then index;
+//                 sorted[place] = body, its bounds to cell_bounds
 // Large bodies (much bigger than a cell; large_body()) are not in the grid.
-//
-// The first two scan passes serve the pair pipeline too (pairs.wgsl): with
-// the override constant SCAN_PAIRS they sum the bodies' pair counts instead
-// (pair_meta's owned and total -> owned_start and list_start, within their
-// blocks), and the single workgroup also writes the narrowphase's indirect
-// dispatch; pairs_write adds each body's block offset (no third pass).
+// With SCAN_PAIRS the scan passes sum the bodies' pair counts instead
+// (pairs.wgsl) and write the narrowphase's dispatch. Choices and their
+// measurements: docs/decisions/broadphase.md.
 
-// SCAN_BLOCK: invocations of a scan workgroup; SCAN_RUN: buckets (or
-// bodies) each sums in turn; SCAN_SPAN: their product, a block (shared with
-// Rust).
+// SCAN_BLOCK, SCAN_RUN and SCAN_SPAN (their product, a block): shared with Rust.
 
 fn cell_of(p: vec3<f32>) -> vec3<i32> {
     return vec3<i32>(floor(p / params.cell_size));
 }
 
-// The bucket of cell c. The cells of each block of 8 x 8 x 8 take a run of
-// 512 consecutive buckets, the run's place hashed from the block, in Morton
-// order within it, so neighbouring cells mostly lie in neighbouring buckets
-// and the grid's order follows space: a pair walk, which visits 14 cells,
-// then finds its candidates beside those of the walker before it. Each cell
-// hashed alone (as before), a million piled cubes' walks missed the caches
-// cell after cell, and 39% of a landed 10k pile's cells shared a bucket
-// with another (the hash's low bits mix small coordinates poorly; a walk
-// reads the other cells' bodies too and passes them by); here two cells
-// share one only where two blocks' runs meet (none in that pile). The
-// Morton place is XORed with bits of the block's hash, so that the cells
-// of a lattice 8 cells apart (all first in their blocks) do not share the
-// first bucket of every run.
+// The bucket of cell c. Each block of 8 x 8 x 8 cells takes a run of 512
+// consecutive buckets (the run placed by the block's hash, Morton order
+// within), so the grid's order follows space and a walk's candidates lie near
+// the last walker's. The Morton place is XORed with hash bits so that a
+// lattice 8 cells apart does not share every run's first bucket.
 fn bucket_of(c: vec3<i32>) -> u32 {
     let u = bitcast<vec3<u32>>(c);
     let block = u >> vec3<u32>(3u);
@@ -66,13 +43,11 @@ fn in_grid(i: u32) -> bool {
     return grid_body(props_of(i));
 }
 
-// The same, from the body's properties already read.
 fn grid_body(p: BodyProps) -> bool {
     return p.grid_class == GRID_BODY;
 }
 
-// How far a body in state s may move in the coming step, all its substeps
-// (m): its last displacement, rescaled to this step, plus what gravity adds.
+// How far a body may move in the coming step (m): its last displacement, rescaled, and gravity.
 fn reach_of(s: BodyState) -> f32 {
     let steps = f32(params.substeps);
     let ratio = params.dt / params.dt_prev * steps;
@@ -80,11 +55,9 @@ fn reach_of(s: BodyState) -> f32 {
     return length(s.disp) * ratio + length(params.gravity) * h * h;
 }
 
-// How far a body's turn (state s, properties p) moves any of its points in
-// the coming step (m), if it keeps the last substep's turn: a unit
-// quaternion's change of d moves a point at r from the centre by at most
-// 2 d r, so at most 2 d R for the bounding radius R, a substep; rescaled as
-// reach_of. (q and -q are one rotation: d is the nearer of the two.) A
+// How far a body's turn moves any of its points in the coming step (m), if it
+// keeps the last substep's turn: a quaternion change of d moves a point at r
+// by at most 2 d r (d the nearer of q and -q), rescaled as reach_of. A
 // sphere turns into itself: 0.
 fn spin_reach_of(s: BodyState, p: BodyProps) -> f32 {
     let ratio = params.dt / params.dt_prev * f32(params.substeps);
@@ -92,22 +65,11 @@ fn spin_reach_of(s: BodyState, p: BodyProps) -> f32 {
     return select(2.0 * turned * p.half_extents.w * ratio, 0.0, p.shape == SHAPE_SPHERE);
 }
 
-// Fast bodies. The pair walk of a body's own cell and its neighbours
-// (pairs.wgsl) finds every body whose centre lies within a cell of the
-// walker's along each axis. Two bodies whose grown boxes (pair_meta's
-// extent: the world box grown by the body's reach) each reach at most
-// fast_size() along every axis are never wanted farther apart: cells are
-// 2.5 bounding radii, so a box may grow by a quarter of a radius or more
-// (a unit cube turned corner-on by 0.21 m a step, 12 m/s at 60 Hz; face-on
-// by 0.58 m). A body whose box reaches farther (`is_fast`: it moves or
-// spins fast) walks every cell within its reach instead (pairs.wgsl's
-// `walk`), and grid_sort marks its CellBound (FAST_BODY) so that no other
-// walk takes a pair with it. Before, such pairs were never listed: a unit
-// cube thrown face-on at another at 300 m/s sank 0.63 m into it (now 8
-// cm; tests/gpu/kernels.rs,
-// the_pair_list_holds_every_pair_within_reach_once_at_any_speed). In a
-// pile of 10 000 cubes dropped from up to 5.7 m, at most four bodies of a
-// step are fast (by a trace of their speeds and spins).
+// Fast bodies. The walk of a cell and its neighbours finds every pair whose
+// grown boxes (pair_meta's extent) reach at most fast_size() along every axis
+// (cells are 2.5 bounding radii: a unit cube at about 12 m/s). A body reaching
+// farther (`is_fast`) walks every cell within its reach instead, and grid_sort
+// marks its CellBound (FAST_BODY) so that no other walk takes its pairs.
 fn fast_size() -> f32 {
     // a thousandth of a cell of slack for the rounding of the cells
     return 0.5 * (0.999 * params.cell_size - CONTACT_MARGIN);
@@ -118,14 +80,12 @@ fn box_size(extent: vec3<f32>) -> f32 {
     return max(extent.x, max(extent.y, extent.z));
 }
 
-// Whether a body of box size `size` is fast. A sleeper never is: it walks
-// no cells (and its reach is nil).
+// Whether a body of box size `size` is fast. A sleeper never is: it walks no cells.
 fn is_fast(size: f32, moves: u32) -> bool {
     return size > fast_size() && moves != SLEEPS;
 }
 
-// Half extents of a body's world box (state s, properties p): |R| h for a
-// box, the radius for a sphere.
+// Half extents of a body's world box: |R| h for a box, the radius for a sphere.
 fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(p.half_extents.x);
@@ -137,10 +97,9 @@ fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     return abs(x) + abs(y) + abs(z);
 }
 
-// Counts body i into its bucket and writes what the pair list reads of it
-// (PairMeta's moves, extent, bound and reach; see pairs.wgsl). Invocation 0
-// also empties the manifold pool's counters and the step's "something
-// moves" flag (the step's first pass).
+// Counts body i into its bucket and writes what the pair walks read of it
+// (PairMeta's moves, extent, bound, reach). Invocation 0 also empties the
+// pool's counters and the step's flags (the step's first pass).
 @compute @workgroup_size(WORKGROUP)
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -156,7 +115,6 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    // the body's state and properties, read once
     let s = state_of(i);
     let p = props_of(i);
     let reach = reach_of(s);
@@ -174,8 +132,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (!grid_body(p)) {
         return;
     }
-    // the pair walks of the bodies that move look for sleepers behind them
-    // too (pairs.wgsl); one store does, the rest see it set
+    // the movers' walks look for sleepers behind them too; one store sets it
     if (sleeps && atomicLoad(&status[11]) == 0u) {
         atomicStore(&status[11], 1u);
     }
@@ -232,11 +189,9 @@ fn scan_written(k: u32) -> vec2<u32> {
     return vec2<u32>(cell_start[k], 0u);
 }
 
-// A block is SCAN_SPAN = SCAN_BLOCK x SCAN_RUN elements: each invocation
-// sums a run of SCAN_RUN in turn, then the workgroup scans the runs' totals
-// (its barriers, not the sums, are what such a pass costs on lavapipe: with
-// one element an invocation the grid's scan took 2.7 ms a step at 10k
-// bodies).
+// A block is SCAN_SPAN = SCAN_BLOCK x SCAN_RUN elements: each invocation sums
+// a run of SCAN_RUN in turn, then the workgroup scans the runs' totals (its
+// barriers, not the sums, are what such a pass costs on lavapipe).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_id) wid: vec3<u32>) {
     let first = wid.x * SCAN_SPAN + lid.x * SCAN_RUN;
@@ -256,9 +211,8 @@ fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_
     for (var h = first; h < end; h = h + 1u) {
         scan_write(h, scan_written(h) + before); // exclusive within the block
     }
-    // one block is the whole scan: its offset is 0 and it finishes the
-    // scan itself, so that scan_sums (and the grid's scan_add) need not run
-    // (`World::step_plan` leaves them out)
+    // one block is the whole scan: its offset is 0 and it finishes the scan
+    // itself, so scan_sums and scan_add need not run (`World::step_plan`)
     let whole = scan_len() <= SCAN_SPAN;
     if (lid.x == SCAN_BLOCK - 1u) {
         block_sums[wid.x] = select(scan_tmp[lid.x], vec2<u32>(0u), whole);
@@ -268,8 +222,7 @@ fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_
     }
 }
 
-// Writes the whole scan's total `sum` past the last entry and, for the
-// pairs, their count and the narrowphase's indirect dispatch.
+// Writes the total `sum` past the last entry and, for the pairs, their count and dispatch.
 fn finish_scan(sum: vec2<u32>) {
     scan_write(scan_len(), sum);
     if (SCAN_PAIRS) {
@@ -282,8 +235,7 @@ fn finish_scan(sum: vec2<u32>) {
 }
 
 // One workgroup turns the block totals into exclusive block offsets, each
-// invocation scanning a run of consecutive blocks first (nothing to do for
-// a scan of one block, which scan_blocks finished).
+// invocation scanning a run of blocks first (none for a scan of one block).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
     if (scan_len() <= SCAN_SPAN) {
@@ -333,26 +285,16 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     sorted[params.body_count + cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
 }
 
-// A grid body's key in its bucket: the low x side of its world box grown
-// by its reach (pair_meta's extent, written by grid_count).
+// A grid body's key in its bucket: the low x side of its grown world box.
 fn grid_key(i: u32) -> f32 {
     return state_of(i).pos.x - pair_meta[i].extent.x;
 }
 
-// The scatter's order within a bucket depends on thread timing; placing
-// each bucket's bodies by key, then index, makes every later pass see the
-// same order every run, and lets a pair walk stop at the first body of a
-// cell whose box begins beyond the walker's reach along x (see pairs.wgsl).
-// Each body counts the bodies of its bucket that come before it (by key,
-// then index): a loop as long as its bucket. (An insertion sort of each
-// bucket by one invocation took a loop as long as the bucket's
-// inversions, about n^2/4 for n bodies at one place, and lavapipe ends
-// every loop of an invocation once their trips sum to 65535 (gallivm's
-// LP_MAX_TGSI_LOOP_ITERATIONS), silently: from 510 boxes placed inside
-// each other their bucket stayed unsorted and most of their pairs were
-// never found.) The bucket's bodies' bounds go to cell_bounds in that
-// order, where the walks read a cell's candidates side by side
-// (CellBound).
+// Each bucket's bodies placed by key, then index: the same order every run
+// (the scatter's depends on thread timing), and a walk may stop at the first
+// box beyond its reach along x. Each body counts those before it, a loop as
+// long as its bucket (an insertion sort's n^2/4 trips pass lavapipe's loop
+// limit). The bounds go to cell_bounds in that order, a cell's side by side.
 @compute @workgroup_size(WORKGROUP)
 fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;

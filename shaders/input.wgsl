@@ -1,14 +1,9 @@
-// User input between steps (src/world/input.rs): impulses, poses,
-// velocities and fixed/dynamic switches of single bodies (entry point
-// `apply_inputs`, one thread per run of ops on one body) and radial
-// explosions and wind (entry points `explode` and `wind`, one thread per
-// body). Assembled after
-// common.wgsl and bindings.wgsl, but it binds only state_out (the current
-// state buffer, rewritten in place) and what it declares below; and Verlet's velocity is
-// implicit, so a change of velocity is a change of the previous pose:
-// v = disp / h (disp = x_n - x_(n-1), see BodyState) and the turn
-// rot * prev_rot^* = exp(w h), where h is the substep that produced them
-// (input.substep_dt).
+// User input between steps (src/world/input.rs): `apply_inputs`, one thread
+// per run of ops on one body (impulses, poses, velocities, fixed/dynamic
+// switches), and `explode` and `wind`, one thread per body. It binds only
+// state_out (the current state, rewritten in place) and its own buffers.
+// Verlet's velocity is implicit, so a velocity change rewrites the previous
+// pose: v = disp / h and rot * prev_rot^* = exp(w h), h the last substep.
 
 struct InputHeader {
     gravity: vec3<f32>, // settings.gravity (m/s^2)
@@ -106,11 +101,9 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             if (fixed) {
                 return s;
             }
-            // as the scene loader does: the next steps follow x + v t + g t^2 / 2,
-            // and the velocity reads back as v (the host adds the half
-            // substep of gravity that disp / h lags by, see body_output,
-            // for a body no contact pressed: given a velocity, it is not
-            // known to rest on anything)
+            // as the scene loader does: the next steps follow x + v t + g t^2 / 2 and
+            // the velocity reads back as v (the host adds the half substep of gravity
+            // disp / h lags by, for a body no contact pressed)
             let v = op.a.xyz;
             s.disp = v * h - 0.5 * input.gravity * (h * h);
             s.pos_low = s.pos_low & ~HELD;
@@ -128,8 +121,7 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 s.pos_low = s.pos_low | HELD;
                 s.prev_rot = s.rot;
             } else if (fixed) {
-                // the mass given, else the one kept when an input made it
-                // fixed, else (loaded fixed: none kept) the scene's
+                // the mass given, else the one kept when made fixed, else the scene's
                 var m = op.a.y;
                 if (m <= 0.0) {
                     m = select(op.a.z, 1.0 / np.kept_inv_mass, np.kept_inv_mass > 0.0);
@@ -137,8 +129,7 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 np.flags = p.flags & ~FLAG_FIXED;
                 np.inv_inertia = vec4<f32>(shape_inv_inertia(p, m), 1.0 / m);
                 np.kept_inv_mass = 0.0;
-                // at rest, as the scene loader starts a body: the next steps
-                // follow x + g t^2 / 2
+                // at rest, as the scene loader starts a body: x + g t^2 / 2 follows
                 s.disp = -0.5 * input.gravity * (h * h);
                 s.pos_low = s.pos_low & ~HELD;
                 s.prev_rot = s.rot;
@@ -173,8 +164,7 @@ fn apply_inputs(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// Every body wakes after any input (see `asleep` in common.wgsl): dispatched
-// over all bodies after each input kernel.
+// Every body wakes after any input (`asleep` in bindings.wgsl): run after each input kernel.
 @compute @workgroup_size(WORKGROUP)
 fn wake_all(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -183,11 +173,9 @@ fn wake_all(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// A radial impulse of input.centre.w (N s) on every dynamic body whose centre
-// lies within input.reach.x of input.centre.xyz, scaled by (1 - d / radius)
-// ^ falloff, along the direction from the centre to the body's centre (up
-// for a body at the centre). It changes the velocity only, by J / m; bodies
-// outside the radius are not written at all.
+// A radial impulse of input.centre.w (N s) on every dynamic body within input.reach.x
+// of input.centre.xyz, scaled by (1 - d / radius) ^ falloff, away from the centre (up
+// at the centre). It changes velocity only, by J / m; bodies outside are not written.
 @compute @workgroup_size(WORKGROUP)
 fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;

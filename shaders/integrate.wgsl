@@ -1,49 +1,21 @@
-// Pass "integrate": the paper's position Verlet, eq. 6 for translation and
-// eq. 7 for rotation, time-corrected for a changing dt (eq. 11) and damped
-// (eq. 12). Reads state_in, writes each body's own slot of state_out (the
-// predicted pose, with the current pose as its previous one) and of vel0.
-// In a step's second substep and later, it first applies what the last
-// substep's restitution_contacts asked of the body (restitution.wgsl),
-// which a pass of its own did before: a dispatch fewer and a read and write
-// of every state fewer a substep, the same bits.
+// Pass "integrate": the paper's position Verlet, eqs. 6 and 7, time-corrected
+// for a changing dt (eq. 11) and damped (eq. 12). Reads state_in, writes each
+// body's own slot of state_out (the predicted pose) and of vel0. After a
+// step's first substep it first applies the last substep's restitution
+// (restitution.wgsl's `restituted`): a dispatch and a state copy fewer.
 //
-// Numerical faults: first, every body's state as read here is checked, every
-// substep, with no readback. A body whose pose is not finite (an infinity or
-// a NaN in pos, disp, rot or prev_rot), lies farther than MAX_DISTANCE
-// from the origin, moved faster than MAX_SPEED or turned faster than MAX_SPIN
-// (or more than MAX_TURN) over the last substep is
+// Numerical faults: every substep, with no readback, a body whose pose is not
+// finite, lies beyond MAX_DISTANCE, or moved or turned faster than MAX_SPEED,
+// MAX_SPIN or MAX_TURN (or its speed_limit) over the last substep is
 // flagged in status[2..4] (bindings.wgsl: the lowest such body of the first
-// step that found any, with that step's index) and stopped: it is parked at
-// rest at its last sane pose (its current one if that is finite and within
-// MAX_DISTANCE, else its previous one, pos - disp, which passed this check
-// last time unless an input wrote it, else its current one with each
-// coordinate that is not finite set to 0, else the origin; its rotation
-// likewise, else none) and the step goes on; the next substep integrates it again from
-// rest. Nothing else changes, so a run with no fault is bit-identical to one
-// without the check. The host reads the flag only on request
-// (World::faults, World::read_state), never in the step loop.
+// step that found any, with that step's index) and parked at rest at its last
+// sane pose; the step goes on. A run with no fault is bit-identical to one
+// without the check, and the host reads the flag only on request.
 
-// Sleeping (see `asleep` in common.wgsl): a body sleeps once it has moved
-// slower than SLEEP_SPEED, at every point, for params.sleep_after seconds
-// while touching something (the solve sets HELD in pos_low when a contact
-// of the body pushed in the substep); a sleeper wakes when an awake body in
-// a pair with it moves faster than WAKE_SPEED at any point or lies more
-// than WAKE_DEPTH inside it (`wakes`, found by the narrowphase; the body
-// wakes one step later, see `wakes_next`); inputs and
-// edits wake every body (input.wgsl's wake_all). Box2D's rule is alike (it
-// sleeps whole islands; this sleeps bodies, and a body's awake partners
-// treat it as fixed).
-
-// A body wakes in a step's first substep, one step after the narrowphase
-// found an awake partner waking it (WOKEN_NOW, moved here to the pose's
-// WAKES bit), so that this step's pair list already holds all of its pairs
-// (pairs.wgsl lists a woken sleeper's pairs as a mover's). The WAKES bit
-// body i's pose carries out of this substep: in the first, the
-// narrowphase's finding (cleared for the next step's); in the others, as
-// it came in. Only a sleeper can have been found woken (wake_check tests
-// the same pose this substep starts from), so an awake body touches no
-// flag: two atomics a body every substep, each a loop over the lanes on
-// lavapipe.
+// The WAKES bit body i's pose carries out of this substep: in the first, the
+// narrowphase's WOKEN_NOW (cleared for the next step), so the body wakes once
+// the pair list holds all its pairs again; in the others, as it came in. Only
+// a sleeper can have been woken, so an awake body touches no atomic.
 fn wakes_next(i: u32, s: BodyState) -> u32 {
     let first = params.substep == 0u;
     var now = 0u;
@@ -57,39 +29,27 @@ fn wakes_next(i: u32, s: BodyState) -> u32 {
 
 // Notes that a body moves, or is due to wake, after the step (status[15]:
 // the world is at rest after a step that noted none), in the step's last
-// substep: a body that fell asleep in an earlier one holds still from then
-// on. Loaded first, so that after the first store of a step the other
-// lanes only read (a store per body every substep cost integrate 15% at
-// 10k, an atomic being a loop over the lanes on lavapipe); the substep
-// enters the condition by a select, beside the load (see above).
+// substep. Loaded before stored, so only the first store of a step writes (an
+// atomic is a loop over the lanes on lavapipe).
 fn moved() {
     if (atomicLoad(&status[15]) < select(0u, 1u, params.substep + 1u == params.substeps)) {
         atomicStore(&status[15], 1u);
     }
 }
 
-// Beyond these a body is absurd (m, m/s, rad/s, rad per substep). A pose
-// pair holds less than half a turn per substep (a bigger turn reads as a
-// smaller one the other way), so a spin is also absurd where it turns more
-// than MAX_TURN in one substep, whatever MAX_SPIN allows.
+// Beyond these a body is absurd; shared with Rust (src/world.rs), which
+// decodes the faults. A pose pair holds less than half a turn, so MAX_TURN
+// bounds a spin whatever MAX_SPIN allows.
+
 // MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN (m, m/s, rad/s, rad per
 // substep), NO_FAULT (status[3] and status[2] before any fault) and what was
 // wrong, in the low three bits of status[2] (8 * body + FAULT_*):
-// FAULT_NON_FINITE, FAULT_FAR, FAULT_FAST, FAULT_SPIN, FAULT_ENERGY; shared
-// with Rust (src/world.rs), which decodes them.
-//
-// A body is also absurd when it moves faster than the scene's energy
-// allows (FAULT_ENERGY): all the energy the scene began with, what gravity
-// can give down to the ground and what pushing out overlap can add, given
-// to this body alone, moves it at BodyProps' speed_limit (twice that speed,
-// for the integration's own error; src/world/records.rs: speed_limits). No
-// collision, joint or restitution of at most 1 adds energy, so a body
-// beyond it was thrown by the solver: fifty boxes placed at one point and
-// landing before they had parted were thrown at 349 m/s, a run that then
-// looked like a success. The limit holds only while nothing else added
-// energy (params.speed_limits: 0 after any input, edit or restore).
+// FAULT_NON_FINITE, FAULT_FAR, FAULT_FAST, FAULT_SPIN, FAULT_ENERGY.
 
-// (all_finite and near: common.wgsl)
+// FAULT_ENERGY: faster than all the scene's energy could move this body alone
+// (BodyProps' speed_limit), which only the solver can do; checked while
+// params.speed_limits holds (nothing has added energy since the scene began).
+
 
 fn usable_rotation(q: vec4<f32>) -> bool {
     let d = dot(q, q);
@@ -141,10 +101,9 @@ fn opaque(v: vec3<f32>) -> vec3<f32> {
     return bitcast<vec3<f32>>(bitcast<vec3<u32>>(v) ^ vec3<u32>(params.opaque_zero));
 }
 
-// No branch here depends on the per-substep parameters alone (selects
-// instead): lavapipe re-specialises a pass whose branch conditions read only
-// uniforms for the uniforms' values at every dispatch, and here that cost
-// 2-3 ms a dispatch (a 10-cube step went from 3.2 to 12 ms).
+// No branch here depends on the per-substep uniforms alone (selects instead):
+// lavapipe re-specialises such a pass for the uniforms' values at every
+// dispatch, at 2-3 ms each (docs/decisions/integration.md).
 @compute @workgroup_size(WORKGROUP)
 fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = listed_body(gid.x);
@@ -152,9 +111,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let p = props_of(i);
-    // the last substep's restitution first (restitution.wgsl's body half,
-    // `restituted`; none before a step's first substep, which follows the
-    // pass "restitution")
+    // the last substep's restitution first (none before a step's first substep)
     let s = restituted(i, state_of(i), p, params.substep != 0u);
     let dt = params.dt;
     let wake = params.substep == 0u && (s.pos_low & WAKES) != 0u;
@@ -164,8 +121,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         report_fault(i, fault);
         var at = vec3<f32>(0.0);
         let prev = s.pos - s.disp;
-        // the current position's finite coordinates (a NaN in one of them
-        // leaves pos - disp no better)
+        // the current position's finite coordinates (pos - disp is no better with a NaN)
         let kept = select(vec3<f32>(0.0), s.pos, (bitcast<vec3<u32>>(s.pos) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u));
         if (near(s.pos)) {
             at = s.pos;
@@ -190,12 +146,10 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
-    // seconds at rest, this substep included (asleep() is false with
-    // sleeping off)
+    // seconds at rest, this substep included (asleep() is false with sleeping off)
     var rest = 0.0;
-    // held by a contact, or by its joints: a joint island sleeps and wakes
-    // as a whole (solve_joints gives every body of it the island's least
-    // rest time)
+    // held by a contact, or by its joints (a joint island sleeps as a whole:
+    // joint_rest gives its bodies the island's least rest time)
     let jointed = joint_start[i] != joint_start[i + 1u];
     let resting = ((s.pos_low & HELD) != 0u || jointed) && point_speed(s, p) < SLEEP_SPEED;
     if (asleep(s)) {
@@ -218,23 +172,19 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ratio = dt / params.dt_prev;
     // eq. 12: damping keeps (1 - beta) of it
     let carry = s.disp * (ratio * (1.0 - params.linear_damping));
-    // constant acceleration: a dt (dt + dt_prev) / 2 is exact for any pair of
-    // steps and equals eq. 6's a dt^2 when dt does not change
+    // gravity: a dt (dt + dt_prev) / 2, exact for any pair of steps (eq. 6's a dt^2)
     let accel = params.gravity * (dt * 0.5 * (dt + params.dt_prev));
     let disp = carry + accel;
-    // pos + disp, with what the last addition's rounding dropped added back
-    // and what this one drops kept (Knuth's TwoSum, exact under
-    // round-to-nearest): the position then follows the displacements to
-    // about 1/1000 of its f32 spacing instead of losing up to half a
-    // spacing every substep
+    // pos + disp by Knuth's TwoSum: what the last addition's rounding dropped is
+    // added back and what this one drops kept, so the position follows the
+    // displacements to about 1/1000 of its f32 spacing
     let add = disp + pos_remainder(s);
     let pos = opaque(s.pos + add);
     let add_part = opaque(pos - s.pos);
     let pos_part = pos - add_part;
     let dropped = (s.pos - pos_part) + (add - add_part);
 
-    // eq. 7 with no torque: repeat the last rotation q_n q_{n-1}^*, scaled by
-    // the step ratio and damped by interpolation towards no rotation
+    // eq. 7 with no torque: repeat the last turn, rescaled and damped towards none
     let last = quat_mul(s.rot, quat_conj(s.prev_rot));
     let keep = ratio * (1.0 - params.angular_damping);
     let turn = select(quat_from_rotvec(quat_to_rotvec(last) * keep), last, keep == 1.0);

@@ -1,16 +1,10 @@
-// Pass "narrowphase", once per step after the pair list (pairs.wgsl): one
-// invocation per candidate pair, dispatched indirectly over the pairs the
-// list holds, computes the pair's manifold once (collide.wgsl; the ground
-// pairs in a pass of their own, narrowphase_ground: up to four of a box's
-// deepest corners or a sphere's lowest point) and, if it has points,
-// stores it in the manifold pool in the two bodies' frames and lists it in
-// both bodies' contact lists. Two boxes get only their separating-axis test
-// here; a face contact is stored pending and clipped by narrowphase_clip,
-// over the top run of the pool. Contacts are generated up to a speculative
-// gap (the distance the pair can close in one step), so fast bodies meet
-// walls instead of passing them. An awake partner that moves fast or lies
-// deep inside a sleeping body wakes it
-// (WOKEN_NOW; see pairs.wgsl and integrate.wgsl).
+// Pass "narrowphase", once per step after the pair list, one invocation per
+// candidate pair: the pair's manifold (collide.wgsl) up to a speculative gap
+// (how far the pair may close in the step, so fast bodies meet walls), stored
+// in the pool in the bodies' frames and listed in both bodies' contact lists.
+// Two boxes get only their separating axis here; a face contact is left for
+// narrowphase_clip, ground pairs for narrowphase_ground. An awake partner
+// moving fast or deep in a sleeper wakes it. See docs/decisions/narrowphase.md.
 
 fn shape_of(i: u32) -> Shape {
     let s = state_of(i);
@@ -23,9 +17,8 @@ fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
     return quat_rotate(quat_conj(s.rot), p - s.pos);
 }
 
-// Body i against the ground, within `margin`: a sphere's lowest point, or
-// the box corners within the margin (at most four: the deepest, listed in
-// corner order). The normal points from the body to the ground.
+// Body i against the ground within `margin`, normal from the body down: a
+// sphere's lowest point, or the deepest four box corners within the margin.
 fn ground_manifold(i: u32, margin: f32) -> Manifold {
     let s = state_of(i);
     let p = props_of(i);
@@ -61,9 +54,8 @@ fn ground_manifold(i: u32, margin: f32) -> Manifold {
             chosen = chosen | (1u << best);
         }
     }
-    // in corner order; each point's place picked by comparison, not by
-    // indexing with the count (an array indexed by a value that differs per
-    // lane is slow to run and to compile on lavapipe)
+    // in corner order, each point's place picked by comparison, not by indexing
+    // with the count (lavapipe keeps a dynamically indexed array in memory)
     for (var k = 0u; k < 8u; k = k + 1u) {
         let w = s.pos + quat_rotate(s.rot, corner(k, p.half_extents.xyz));
         let on_ground = vec3<f32>(w.x, ground, w.z);
@@ -94,9 +86,8 @@ fn wake_check(sleeper: u32, other: u32, gap: f32) {
     }
 }
 
-// Stores manifold m of bodies a and b (b may be GROUND) in pool slot
-// `slot`, its points in the bodies' own frames, and wakes a sleeper that an
-// awake partner presses or hits.
+// Stores manifold m of bodies a and b (b may be GROUND) in `slot`, its points in
+// the bodies' own frames, and wakes a sleeper that an awake partner presses or hits.
 fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
     var kept: ManifoldPoints;
     var deepest = 3.4e38;
@@ -112,9 +103,8 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
     }
     set_manifold(slot, ContactManifold(m.normal, m.count, a, b, NONE, pair));
     store_points(slot, kept);
-    // only an awake partner wakes a sleeper, so of the two checks (a by b,
-    // b by a) only the one for a sleeping a can act if a sleeps, only the
-    // other if not: one check, one copy of it in the kernel
+    // only an awake partner wakes a sleeper, so one check (of whichever end
+    // sleeps) does: one copy of it in the kernel
     if (b != GROUND && m.count > 0u) {
         let a_sleeps = asleep(state_of(a));
         wake_check(select(b, a, a_sleeps), select(a, b, a_sleeps), deepest);
@@ -147,8 +137,7 @@ fn new_manifold(a: u32, b: u32, to_clip: bool) -> u32 {
     return slot;
 }
 
-// Appends contact reference r to body i's list (which has room for all of
-// the body's pairs; the cursor counts from 0 after the pair scan).
+// Appends contact reference r to body i's list (room for all its pairs).
 fn list_contact(i: u32, r: u32) {
     let k = pair_meta[i].list_start + atomicAdd(&pair_meta[i].cursor, 1u);
     if (k < arrayLength(&body_pairs)) {
@@ -156,9 +145,8 @@ fn list_contact(i: u32, r: u32) {
     }
 }
 
-// Whether a joint joins body a to body b: one of a's joint ends has b for
-// partner. Asked here, once a pair, not in the pair walks (pairs.wgsl),
-// where the loop cost every candidate of every walk.
+// Whether a joint joins body a to body b. Asked here, once a pair, not in the
+// pair walks, where the loop cost every candidate loop trips.
 fn joined(a: u32, b: u32) -> bool {
     var found = false;
     let end = joint_start[a + 1u];
@@ -175,18 +163,15 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     let pr = pairs[p];
-    // ground pairs: narrowphase_ground; bodies joined by a joint do not
-    // collide (the joint holds them together where their shapes meet)
+    // ground pairs: narrowphase_ground; joined bodies do not collide
     if (pr.b == GROUND || joined(pr.a, pr.b)) {
         return;
     }
     let a = shape_of(pr.a);
     let b = shape_of(pr.b);
     let margin = pair_margin(pr.a, pr.b);
-    // Two boxes get their separating axis here; a face contact's clipping,
-    // the costly part, waits for narrowphase_clip over the face manifolds
-    // only. Each step below has one call site, so the kernel holds one copy
-    // of it (lavapipe's compile time grows steeply with a kernel's size).
+    // each step below has one call site, so the kernel holds one copy of it
+    // (lavapipe's compile time grows steeply with a kernel's size)
     let boxes = a.kind == SHAPE_BOX && b.kind == SHAPE_BOX;
     var axis = BoxAxis();
     var m = empty_manifold();
@@ -215,11 +200,9 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     store_manifold(slot, pr.a, pr.b, p, m);
 }
 
-// Pass "narrowphase_ground", after the narrowphase, one invocation per
-// body: the body's contact with the ground, if it has a ground pair (the
-// first pair it owns, see pairs.wgsl's walk). A pass of its own, so that
-// the narrowphase's vectors of packed invocations do not run the ground's
-// code beside the boxes' (lavapipe runs every branch any of them takes).
+// Pass "narrowphase_ground", per body: its contact with the ground, if it has
+// a ground pair (the first it owns). A pass of its own, so the narrowphase's
+// vectors do not run the ground's code beside the boxes' (every branch taken).
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase_ground(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -239,12 +222,10 @@ fn narrowphase_ground(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// Pass "narrowphase_clip", after contact_lists (which sizes its dispatch,
-// over the whole pool), one invocation per face contact the narrowphase left
-// pending (clip_face; the top run of the pool, see new_manifold): its
-// points, so the clipping runs only where boxes touch face-on; invocations
-// past that run return at once. (A face contact whose clipping keeps no
-// point stays, empty: it pushes nothing.)
+// Pass "narrowphase_clip", after contact_lists (which sizes its dispatch), one
+// invocation per face contact the narrowphase left pending (the pool's top
+// run): its points, so the clipping runs only where boxes touch face-on. A
+// face contact whose clipping keeps no point stays, empty: it pushes nothing.
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let nth = dispatch_index(gid, groups);
@@ -262,19 +243,13 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
     store_manifold(k, ia, ib, head.pair, m);
 }
 
-// Pass "contact_lists", once after the narrowphase, one invocation per body:
-// sorts the contact references (contact_ref) the narrowphase listed for the
-// body (in the order the pool's slots were taken, which depends on thread
-// timing; `sort_short_list`, or in place by insertion where there are more
-// than SHORT_LIST) into pair order: the pairs the body is in by the
-// partner's walk, by pair index, then the pairs it owns, in the order its
-// walk found them.
-// The solve and restitution sum a body's manifolds in this order, the same
-// every run. The count goes to pair_meta's `contacts`, and how many of them
-// are with an end that stays (the ground, a fixed or a sleeping body) to
-// its `held`, and from those and its shares of the pushes with partners
-// that move its `normal_split` (both for solve.wgsl's splits). Invocation
-// 0 also writes the contact passes' indirect dispatch, over the manifolds
+// Pass "contact_lists", once after the narrowphase, per body: sorts the
+// contact references the narrowphase listed (in the order slots were taken,
+// which depends on thread timing) into pair order (list_order), the order the
+// solve and restitution sum in. Counts them (`contacts`), those with an end
+// that stays (`held`) and the normal pushes' split (`normal_split`), and lists
+// the body for the body passes. Invocation 0 also writes the contact passes'
+// indirect dispatch, over the manifolds
 // the pool holds (status[12..15]).
 @compute @workgroup_size(WORKGROUP)
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -320,48 +295,35 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     pair_meta[i].held = held;
     let jointed = is_jointed(i);
     pair_meta[i].normal_split = select(1.0, max(1.0, params.relaxation * (f32(held) + movers)), held > 0u && !jointed);
-    // the bodies the step may change, for the body passes (`listed_body`
-    // in bindings.wgsl): all but the sleepers held still that nothing woke
-    // and that narrowphase_clip cannot wake (listing a sleeper that stays
-    // asleep changes nothing: integrate holds it, the others copy it)
+    // the bodies the step may change, for the body passes (`listed_body`): all
+    // but the sleepers held still that nothing woke or may wake (listing one
+    // changes nothing: integrate holds it, the others copy it)
     if (!sleeps_held(i) || atomicLoad(&pair_meta[i].woken) != 0u || may_wake) {
         list_body(i);
     }
 }
 
-// The loop trips of this body's sort so far, counted as the driver counts
-// them (see `trips` in pairs.wgsl): every trip, and the trip that ends a
-// loop.
+// The loop trips of this body's sort so far, as the driver counts them (see
+// `trips` in pairs.wgsl).
 var<private> list_trips: u32;
 
 // Sets status[21] if this body's sort may have been cut short: a list
 // left out of order sums its snaps in an order that may change from run to
-// run (a box on 5000 fixed boxes placed at one spot diverged at step 33 or
-// 46 by the run; one on 4000 rested). The driver counts the trips of the 8
-// invocations it runs side by side once, as many as the longest takes, so
-// a long list beside short ones is cut where its own count reaches the
-// limit, and that is what is tested. (Where several long lists lie side by
-// side, their inner loops' different counts on the same outer trip add up,
-// and a sort may be cut a little sooner: not reported. Counted so, lists of
-// 1000 to 5000 filled in random order took 21 000 to 71 000 trips; from
-// about 4500 the sort was cut.) `n`: the list's length, walked once more
-// below.
+// run. The driver counts the trips of the 8 invocations side by side once, as
+// many as the longest takes, so a long list is cut where its own count
+// reaches the limit, and that is tested. `n`: the list's length, walked again.
 fn note_long_lists(n: u32) {
     if (list_trips + n + 1u >= LOOP_TRIPS) {
         atomicStore(&status[21], 1u);
     }
 }
 
-// The longest list `sort_short_list` sorts (most bodies of a pile have two
-// to six manifolds; 12 was slower: more work for every list).
+// The longest list sorted in registers (a pile's bodies have 2 to 6 manifolds).
 const SHORT_LIST: u32 = 8u;
 
 // Sorts the `n` (at most SHORT_LIST) contact references from body_pairs[first]
-// by list_order: each reference and its key read once, sorted in registers
-// by odd-even transposition (the loops have fixed counts, so they unroll and
-// every index is a constant), written back once. An insertion sort in
-// place read two words (the reference and its manifold's header) for every
-// comparison: `contact_lists` 1.62 -> 1.06 ms on a landed pile-10k.
+// by list_order in registers: read once, sorted by odd-even transposition
+// (fixed loops unroll, every index a constant), written back once.
 fn sort_short_list(first: u32, n: u32) {
     var refs: array<u32, SHORT_LIST>;
     var keys: array<u32, SHORT_LIST>;
@@ -392,16 +354,10 @@ fn sort_short_list(first: u32, n: u32) {
 }
 
 // Sorts the `n` (more than SHORT_LIST) contact references from
-// body_pairs[first] by list_order, in place. lavapipe ends every loop of an
-// invocation (of the 8 it runs side by side) once their trips sum to 65535
-// (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS), silently, so no sort here may
-// take more. An insertion sort takes as many trips as the list has
-// inversions: few for a long list the narrowphase filled in about pair
-// order (2000 boxes on one slab), but n^2/4 in random order: 600 boxes
-// placed inside each other kept part-sorted lists, and their sums ran in
-// an order that changed from run to run. So the insertion sort stops after
-// INSERTION_TRIPS, and a heap sort (about 1.5 n log2 n trips) finishes a
-// list it left: the same order either way, the keys being unique.
+// body_pairs[first] by list_order, in place. An insertion sort takes as many
+// trips as the list has inversions (n^2/4 in random order, past lavapipe's
+// loop limit), so it stops after INSERTION_TRIPS and a heap sort (about
+// 1.5 n log2 n trips) finishes: the same order either way, the keys unique.
 const INSERTION_TRIPS: u32 = 8192u;
 
 fn sort_long_list(first: u32, n: u32) {
@@ -428,9 +384,8 @@ fn sort_long_list(first: u32, n: u32) {
     if (sorted_to == n) {
         return;
     }
-    // a max-heap of the list (n / 2 sifts), then its largest moved to the
-    // end n - 1 times, each followed by a sift (one loop, one call site:
-    // one copy of sift_down in the kernel)
+    // a max-heap of the list (n / 2 sifts), then its largest moved to the end
+    // n - 1 times, each followed by a sift (one loop: one copy of sift_down)
     let heaped = n / 2u;
     for (var t = 0u; t < heaped + n - 1u; t = t + 1u) {
         var root = 0u;
@@ -449,8 +404,7 @@ fn sort_long_list(first: u32, n: u32) {
     list_trips = list_trips + 1u;
 }
 
-// Moves the reference at place `root` of the heap of `n` from
-// body_pairs[first] down to where its key is no less than its children's.
+// Sifts the reference at `root` of the heap of `n` from body_pairs[first] down.
 fn sift_down(first: u32, root_in: u32, n: u32) {
     var root = root_in;
     let r = body_pairs[first + root];
@@ -479,14 +433,10 @@ fn sift_down(first: u32, root_in: u32, n: u32) {
     body_pairs[first + root] = r;
 }
 
-// Whether body i is a sleeper the step leaves as it is unless something
-// wakes it: pair_meta's SLEEPS (not due to wake), held as integrate holds a
-// sleeper (no displacement, no turn, HELD; compared bit for bit, as
-// integrate writes them), so that integrate would write back what it reads
-// and the other passes copy it; sane (finite, within MAX_DISTANCE: such a
-// pose passes integrate's fault checks, and one that would not, restored
-// from a snapshot, is listed so that integrate finds the fault); not on a
-// joint (solve_joints shares rest times within an island, in place).
+// Whether body i is a sleeper the step leaves as it is unless something wakes
+// it: SLEEPS, held as integrate holds a sleeper (no displacement or turn, HELD;
+// bit for bit), so every pass would copy it; sane (else integrate must see its
+// fault); not on a joint (joint_rest writes rest times in place).
 fn sleeps_held(i: u32) -> bool {
     let s = state_of(i);
     let still = all(bitcast<vec3<u32>>(s.disp) == vec3<u32>(0u)) && all(bitcast<vec4<u32>>(s.prev_rot) == bitcast<vec4<u32>>(s.rot));
@@ -496,8 +446,7 @@ fn sleeps_held(i: u32) -> bool {
 
 // Where contact reference r goes in its body's list: pairs the body does not
 // own (it is end b) first, then owned ones, each by pair index (the owner
-// writes its pairs in walk order; a pair index stays below 2^31, see
-// world.rs's pair_capacities).
+// writes them in walk order; a pair index stays below 2^31: pair_capacities).
 fn list_order(r: u32) -> u32 {
     return manifold_of(r >> 1u).pair | select(0x80000000u, 0u, (r & 1u) != 0u);
 }

@@ -1,23 +1,18 @@
-// Off-screen rendering of a world (host code: src/render.rs).
-//
-// The bodies are drawn straight from the world's current state buffer,
-// bound read-only: one instance per body, a unit mesh (cube or icosphere)
-// scaled by the body's size, turned by its quaternion and moved to its
-// centre in the vertex shader. Nothing is read back to draw.
+// Off-screen rendering of a world (host code: src/render.rs). The bodies are
+// drawn straight from the world's current state buffer, bound read-only: one
+// instance per body, a unit mesh (cube or icosphere) scaled, turned and moved
+// to its centre in the vertex shader, so nothing is read back to draw.
 //
 // Two passes, four pipelines, all reading bind group 0:
 //   shadow_vertex                    the bodies' depth as the sun sees them
 //   body_vertex / body_fragment      the bodies, lit (sun, shadows, sky ambient)
 //   ground_vertex / ground_fragment  the plane y = height, with a grid
 //   joint_vertex / joint_fragment    optional joint lines, drawn on top
-// Group 1 (the shadow map) is bound in the second pass only.
-//
-// Depth is reversed (near = 1, far = 0, infinite far plane): a 32-bit float
-// depth buffer then keeps its precision from a body at the near plane to
-// the horizon of the ground.
+// Group 1 (the shadow map) is bound in the second pass only. Depth is reversed
+// (near = 1, far = 0, infinite far plane), so a 32-bit float depth buffer
+// keeps its precision from the near plane to the horizon.
 
-// BodyState, quat_rotate, SHAPE_BOX and SHAPE_SPHERE come from common.wgsl
-// and the shared constants, put before this file (src/render.rs).
+// BodyState, quat_rotate and SHAPE_* come from common.wgsl and the shared constants.
 
 // The renderer's constants (208 bytes), written once; `Globals` in src/render.rs.
 struct Globals {
@@ -27,13 +22,11 @@ struct Globals {
     light_view_proj: mat4x4<f32>,
     // xyz = camera position (m)
     eye: vec4<f32>,
-    // xyz = unit vector towards the sun; w = how far a lookup in the shadow
-    // map moves out along the normal (m), against self-shadowing speckle
+    // xyz = unit vector towards the sun; w = shadow lookups' offset along the normal (m)
     light_dir: vec4<f32>,
     // x = ground height (m), y, z = centre of the drawn square (m), w = its half size (m)
     ground: vec4<f32>,
-    // x = minor grid spacing (m), y = major spacing (m), z, w = distances from
-    // the eye where fog starts and where it hides everything (m)
+    // x, y = minor and major grid spacing (m); z, w = where fog starts and is total (m)
     grid: vec4<f32>,
     // rgb = background colour (linear)
     background: vec4<f32>,
@@ -52,8 +45,7 @@ struct RenderBody {
     shape: u32,
 }
 
-// One ball joint (32 bytes); `JointLine` in src/render.rs. A body index of
-// -1 is the world, whose anchor is in world coordinates.
+// One ball joint (32 bytes); `JointLine` in src/render.rs. Body -1 is the world.
 struct JointLine {
     anchor_a: vec3<f32>,
     body_a: i32,
@@ -68,8 +60,7 @@ struct JointLine {
 @group(1) @binding(0) var shadow_map: texture_depth_2d;
 @group(1) @binding(1) var shadow_sampler: sampler_comparison;
 
-// The share of sunlight reaching a point (0 = in shadow), filtered over 3x3
-// texels of the shadow map. Outside the map everything is lit.
+// The share of sunlight reaching a point (0 = shadow), 3x3-filtered; lit outside the map.
 fn sunlit(world_pos: vec3<f32>, n: vec3<f32>) -> f32 {
     // move out along the normal by about a texel, so a surface does not shadow itself
     let p = world_pos + n * globals.light_dir.w;
@@ -102,9 +93,7 @@ fn shade(albedo: vec3<f32>, n: vec3<f32>, world_pos: vec3<f32>) -> vec3<f32> {
     return albedo * (ambient + sun * diffuse) + vec3<f32>(specular);
 }
 
-// ---------------------------------------------------------------------------
 // Bodies
-// ---------------------------------------------------------------------------
 
 // A body's point of the unit mesh in world coordinates.
 fn body_point(mesh_pos: vec3<f32>, b: RenderBody) -> vec3<f32> {
@@ -159,8 +148,7 @@ fn body_fragment(in: BodyOut) -> @location(0) vec4<f32> {
     // box: distance to the nearest edge is the middle one of the distances to the three faces
     let d = max(in.half_extents - abs(in.local_pos), vec3<f32>(0.0));
     let middle = d.x + d.y + d.z - min(d.x, min(d.y, d.z)) - max(d.x, max(d.y, d.z));
-    // a darker band about a pixel wide along every edge, so faces read apart
-    // (derivatives are taken here, in uniform control flow, for both shapes)
+    // a darker band about a pixel wide along every edge, so faces read apart (uniform control flow)
     let px = fwidth(middle);
     let edge = 1.0 - smoothstep(0.5 * px, 1.5 * px, middle);
     // sphere: two tones by octant of the body frame, so a spin shows
@@ -175,9 +163,7 @@ fn body_fragment(in: BodyOut) -> @location(0) vec4<f32> {
     return vec4<f32>(shade(albedo, n, in.world_pos), 1.0);
 }
 
-// ---------------------------------------------------------------------------
 // Ground
-// ---------------------------------------------------------------------------
 
 struct GroundOut {
     @builtin(position) clip: vec4<f32>,
@@ -200,9 +186,8 @@ fn ground_vertex(@builtin(vertex_index) i: u32) -> GroundOut {
     return out;
 }
 
-// Coverage (0..1) of grid lines one pixel wide at integer values of `coord`,
-// antialiased by the screen-space footprint, and faded out where cells
-// shrink to a few pixels, before they alias into moiré.
+// Coverage (0..1) of one-pixel grid lines at integer `coord`, antialiased by the
+// screen-space footprint and faded where cells shrink to a few pixels (moiré).
 fn grid_lines(coord: vec2<f32>) -> f32 {
     let w = max(fwidth(coord), vec2<f32>(1e-6));
     // distance to the nearest line, in pixels
@@ -224,17 +209,14 @@ fn ground_fragment(in: GroundOut) -> @location(0) vec4<f32> {
     return vec4<f32>(mix(lit, globals.background.rgb, fog), 1.0);
 }
 
-// ---------------------------------------------------------------------------
 // Joint lines
-// ---------------------------------------------------------------------------
 
 struct LineOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) color: vec3<f32>,
 }
 
-// An anchor in world coordinates: a body's local anchor moved by its pose,
-// or a world anchor as it is.
+// An anchor in world coordinates: a body's local anchor moved by its pose, or the world's.
 fn anchor_world(body: i32, anchor: vec3<f32>) -> vec3<f32> {
     if body < 0 {
         return anchor;
@@ -251,9 +233,8 @@ fn centre_of(body: i32, anchor: vec3<f32>) -> vec3<f32> {
     return states[u32(body)].pos;
 }
 
-// Three segments per joint (instance), two vertices each: centre of A to
-// its anchor, anchor A to anchor B (the joint's error, zero when it holds),
-// anchor B to the centre of B.
+// Three segments per joint, two vertices each: centre of A to its anchor, anchor A
+// to anchor B (the joint's error, zero when it holds), anchor B to the centre of B.
 @vertex
 fn joint_vertex(@builtin(vertex_index) v: u32, @builtin(instance_index) j: u32) -> LineOut {
     let jl = joints[j];

@@ -1,22 +1,13 @@
 // Passes "restitution_contacts", once per substep after the solve, and
-// "restitution", once per step after the last substep's: collisions change
-// velocity by rewriting the previous pose (the paper, section III; here
-// the displacement from it and the previous rotation). A contact
-// that was approaching faster than a resting contact can (2 |g| dt), and
-// faster than RESTITUTION_THRESHOLD, leaves with -e times its approach speed
-// along the normal; slower ones stay at rest, so resting bodies do not hop.
-// The floor matters with substeps: at dt = 1/480 s, 2 |g| dt is 4 cm/s, and
-// a limb held against a surface by a joint then bounced every substep and
-// pumped energy in (a ragdoll's forearm jittered forever). Dynamic friction acts here too: a
-// contact still sliding after the solve loses up to mu times the normal
-// velocity change its push made (mu |dv_n|, Coulomb's law per substep).
-// Every contact is measured on the velocities after the solve, once per
-// manifold (restitution_contacts, which writes what it asks of each body to
-// its two EndSnaps in snaps and empties its points' friction budgets); each body sums
-// what its manifolds ask (`restituted`), the turns split among the contacts
-// that acted as in the solve, the bounces combined by direction: in the
-// pass "restitution" after the step's last substep, and in the next
-// substep's integrate after the others.
+// "restitution", after the step's last substep: collisions change velocity by
+// rewriting the previous pose (the paper, section III; here disp and
+// prev_rot). A contact that approached faster than both RESTITUTION_THRESHOLD
+// and what a resting contact can reach (2 |g| dt) leaves at -e times its
+// approach speed; slower ones stay at rest, so resting bodies do not hop.
+// Dynamic friction takes up to mu times the push's normal impulse from a
+// contact still sliding. As in the solve, restitution_contacts measures each
+// manifold once (two EndSnaps; it empties the friction budgets) and
+// `restituted` sums a body's in pair order. See docs/decisions/restitution.md.
 
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
@@ -43,9 +34,8 @@ fn end_velocity(i: u32, e: ContactEnd) -> Velocity {
     return pose_velocity(e.disp, e.rot, e.prev_rot);
 }
 
-// ... and before it (integrate's vel0): zero for an end the contacts may
-// not move, as integrate writes for a fixed body or a sleeper (a sleeper
-// the step leaves as it is is not integrated, see `listed_body`).
+// ... and before it (integrate's vel0): zero for an end the contacts may not move,
+// as integrate writes for a fixed body or a sleeper (an unlisted one is not integrated).
 fn end_velocity_before(i: u32, e: ContactEnd) -> Velocity {
     if (!e.moves) {
         return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
@@ -90,9 +80,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     } else if (!ea.moves) {
         split = friction_split(b, 1.0);
     }
-    // summed over the points: the velocity change asked of b (a gets the
-    // opposite), times the inverse masses later, and its moments; the
-    // bounces apart, with the sum of their points' 1 / w
+    // summed over the points: the velocity change asked of b (a gets the opposite;
+    // times the inverse masses later), its moments; the bounces apart, with their 1 / w
     var j = vec3<f32>(0.0);
     var moment_a = vec3<f32>(0.0);
     var moment_b = vec3<f32>(0.0);
@@ -110,8 +99,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         if (dot((eb.pos + rb) - (ea.pos + ra), n) > CONTACT_SLOP) {
             continue;
         }
-        // velocity of a's point relative to b's after the solve, and the
-        // approach speed along n before it
+        // a's point's velocity relative to b's after the solve; the approach before it
         let relative_now = point_velocity(va, ra) - point_velocity(vb, rb);
         let approach = -dot(point_velocity(va0, ra) - point_velocity(vb0, rb), n);
         var impulse = vec3<f32>(0.0);
@@ -122,21 +110,16 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         let sliding = length(v_t);
         if (pt.pushed > 0.0 && sliding > 1e-6) {
             let t = v_t / sliding;
-            // Coulomb's bound is on the impulse: mu times the normal one,
-            // the push's velocity through the inverse mass along n (bounding
-            // the velocity change along t by mu times the push's instead
-            // left a sliding ball 3.5 times too little friction: along t
-            // its contact point moves by 1 / m + r^2 / I = 3.5 / m an
-            // impulse, along n by 1 / m; a box flat on a face has the same
-            // inverse mass both ways at its corners)
+            // Coulomb's bound is on the impulse: mu times the normal one (the
+            // push through the inverse mass along n); bounding the velocity
+            // change instead gave a sliding ball 3.5 times too little friction
             let w_t = end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t);
             let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
             let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / (split * w_t));
             impulse = impulse + t * j;
             acted = true;
         }
-        // restitution of a fast approach (approach < 0: closing), both
-        // speeds along a's push direction -n
+        // restitution of a fast approach (approach < 0: closing), along a's push -n
         let vn = -dot(relative_now, n);
         let target_vn = -e * approach;
         if (approach < -threshold && vn < target_vn) {
@@ -156,12 +139,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         }
     }
     // Each point's bounce is computed as if it alone turned the approach
-    // around; summed, the points of one face ask up to their count times too
-    // much where they lie near the middle of a body (a box landing flat
-    // across four sleeping boxes had sixteen points, and left at 40 m/s
-    // after hitting them at 14), so the sum is scaled to what moving the
-    // two bodies apart without turning asks for, never up, as the solve's
-    // pushes are. (Several manifolds asking one bounce: see restitution.)
+    // around, so the sum is scaled down to what moving the two bodies apart
+    // without turning asks, never up, as the solve's pushes are.
     var pair_w = 0.0;
     if (ea.moves) {
         pair_w = pair_w + ea.inv_inertia.w;
@@ -178,13 +157,10 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     set_snap(contact_ref(k, true), end_snap(eb, j, moment_b, acting, flags));
 }
 
-// The body half: body i's state s with what its manifolds ask applied
-// (restitution_contacts' snaps, summed in pair order), or s itself for a
-// body that is fixed, asleep or touches nothing, or where nothing is
-// `pending`. The pass `restitution` applies it after the step's last
-// substep; integrate applies it, pending, before every later substep, one
-// pass fewer a substep (see integrate.wgsl). `pending` enters by a select,
-// not a branch (see integrate).
+// The body half: body i's state with what its manifolds ask applied (summed in
+// pair order), or s_in itself for a body fixed, asleep or touching nothing, or
+// where nothing is `pending`. The pass `restitution` applies it after the last
+// substep, integrate before every later one; `pending` enters by a select.
 fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState {
     var s = s_in;
     let first = pair_meta[i].list_start;
@@ -194,12 +170,9 @@ fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState
     var dw = vec3<f32>(0.0);
     var acting = 0u;
     // Manifolds that bounce the body the same way each ask for the whole
-    // bounce: summed, a box landing across four boxes that stay got four
-    // times its bounce (11 m/s after hitting them at 14, restitution 0.2).
-    // So a bouncing manifold's change is added only as far as the changes
-    // added before it fall short of it along its own direction: bounces the
-    // same way count as the largest of them, bounces at right angles (a ball
-    // rolling into a wall off the ground) each in full.
+    // bounce, so a bouncing manifold adds only what the changes before it fall
+    // short of along its direction: bounces the same way count once, at right
+    // angles each in full.
     var bounces = vec3<f32>(0.0);
     // the body's manifolds in pair order (contact_lists)
     for (var e = first; e < end; e = e + 1u) {
