@@ -5,13 +5,18 @@
 
 use std::path::PathBuf;
 
-use crate::scene::{classify_json_error, one_line, text_problem, JsonFault};
+use crate::json::{classify_json_error, one_line, text_problem, JsonFault};
+
+/// The most bodies any world holds: `scenes::MAX_BODIES`, which checks
+/// that the two agree. Kept here too so that the loaders depend on nothing
+/// above them (the built-in scenes build on the scene types).
+const MAX_BODIES: u64 = 1 << 20;
 
 /// The most bytes a scene or track file may hold: 1 KiB for each of the
-/// most bodies any world holds (`scenes::MAX_BODIES`); a scene as
-/// `verlet scene` writes it takes about 340 bytes a body, a chain link with
-/// its joint about 380. 1 GiB: a bound on memory, not a format limit.
-pub const MAX_FILE_BYTES: u64 = 1024 * crate::scenes::MAX_BODIES;
+/// most bodies any world holds; a scene as `verlet scene` writes it takes
+/// about 340 bytes a body, a chain link with its joint about 380. 1 GiB: a
+/// bound on memory, not a format limit.
+pub const MAX_FILE_BYTES: u64 = 1024 * MAX_BODIES;
 
 /// Which kind of file an error is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -112,7 +117,7 @@ impl LoadError {
             io(std::io::Error::other(format!(
                 "it is larger than {MAX_FILE_BYTES} bytes, more than a {} for the most bodies a world holds ({}) needs",
                 file.noun(),
-                crate::scenes::MAX_BODIES
+                MAX_BODIES
             )))
         };
         let mut from = std::fs::File::open(path).map_err(io)?;

@@ -46,8 +46,9 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use crate::json::{path_string, Obj};
 use crate::load_error::FileKind;
-use crate::scene::{path_string, position_problem, speed_problem, Obj};
+use crate::scene::{position_problem, speed_problem};
 use crate::world::input::{BodyInput, Point, Wind};
 use crate::{Error, World};
 

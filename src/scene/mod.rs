@@ -371,5 +371,4 @@ mod write;
 use load::*;
 use validate::*;
 
-pub(crate) use load::{classify_json_error, one_line, path_string, text_problem, JsonFault, Obj};
 pub use validate::{dt_too_short, mass_problem, position_problem, speed_problem, spin_problem, MIN_BOUNDING_RADIUS};
