@@ -1,4 +1,4 @@
-// Off-screen rendering of a world (host code: src/render.rs). The bodies are
+// Off-screen rendering of a world (host code: src/render/mod.rs). The bodies are
 // drawn straight from the world's current state buffer, bound read-only: one
 // instance per body, a unit mesh (cube or icosphere) scaled, turned and moved
 // to its centre in the vertex shader, so nothing is read back to draw.
@@ -14,7 +14,7 @@
 
 // BodyState, quat_rotate and SHAPE_* come from common.wgsl and the shared constants.
 
-// The renderer's constants (208 bytes), written once; `Globals` in src/render.rs.
+// The renderer's constants (208 bytes), written once; `Globals` in src/render/gpu.rs.
 struct Globals {
     // world -> clip, reversed depth
     view_proj: mat4x4<f32>,
@@ -32,7 +32,7 @@ struct Globals {
     background: vec4<f32>,
 }
 
-// One drawn body (32 bytes); `RenderBody` in src/render.rs. Boxes come
+// One drawn body (32 bytes); `RenderBody` in src/render/gpu.rs. Boxes come
 // first, then spheres, so each mesh is one instanced draw over a range.
 struct RenderBody {
     // box: half extents (m); sphere: the radius in all three
@@ -45,7 +45,7 @@ struct RenderBody {
     shape: u32,
 }
 
-// One ball joint (32 bytes); `JointLine` in src/render.rs. Body -1 is the world.
+// One ball joint (32 bytes); `JointLine` in src/render/gpu.rs. Body -1 is the world.
 struct JointLine {
     anchor_a: vec3<f32>,
     body_a: i32,
