@@ -1,5 +1,5 @@
 //! The benchmark's workloads, shared by `verlet bench` (the harness, in
-//! the binary: src/harness.rs) and criterion's `benches/step.rs`: the named
+//! the binary: src/bin/verlet/bench/) and criterion's `benches/step.rs`: the named
 //! cases, each a built-in scene at a size, and a memory-bound copy of the
 //! state, the physical floor of a pass over the bodies. The library holds
 //! no peer engine; the harness runs rapier3d beside these.

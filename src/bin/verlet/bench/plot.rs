@@ -4,7 +4,7 @@
 //! into its parts (GPU timestamps), stacked. SVG only: its text is left to
 //! the viewer's fonts, so drawing it needs no font files.
 
-use crate::harness::Report;
+use super::results::Report;
 use plotters::prelude::*;
 
 /// One case as the chart shows it.

@@ -1,0 +1,284 @@
+//! The rapier3d peer of `verlet bench` (feature `rapier`): the same scene
+//! stepped on the CPU, its repetitions taken between ours. Without the
+//! feature there is no peer, and `PeerReps` has no value.
+
+#[cfg(feature = "rapier")]
+use std::sync::Arc;
+#[cfg(feature = "rapier")]
+use std::time::Instant;
+
+use verlet::bench::Case;
+use verlet::scene::Scene;
+use verlet::Error;
+
+#[cfg(feature = "rapier")]
+use super::median;
+use super::results::PeerResult;
+use super::Options;
+
+/// The identical scene in rapier3d: same bodies (shapes, sizes, masses,
+/// poses, velocities), friction combined as our geometric mean and
+/// restitution as our max, the ground as a fixed half-space, the same dt,
+/// gravity and damping (our β per step as rapier's coefficient
+/// `-ln(1 - β) / dt`), ball joints as spherical impulse joints whose bodies
+/// do not collide (as ours do not), world-pinned ends on a fixed body at the
+/// origin. Bodies never sleep unless asked; CCD is off as rapier's default.
+#[cfg(feature = "rapier")]
+mod rapier {
+    use std::sync::Arc;
+
+    use rapier3d::na::Unit;
+    use rapier3d::prelude::*;
+    use rapier3d::rayon::{ThreadPool, ThreadPoolBuilder};
+
+    use verlet::scene::{Scene, Shape};
+
+    /// The peer's name as reported.
+    pub const ENGINE: &str = "rapier3d 0.36";
+
+    /// A rayon pool of `threads` threads for `RapierWorld::new`.
+    pub fn pool(threads: usize) -> Result<Arc<ThreadPool>, String> {
+        ThreadPoolBuilder::new().num_threads(threads).build().map(Arc::new).map_err(|e| e.to_string())
+    }
+
+    pub struct RapierWorld {
+        pub world: PhysicsWorld,
+    }
+
+    impl RapierWorld {
+        /// The scene, stepped in `pool` (rapier's parallel pipeline runs
+        /// its whole step there).
+        pub fn new(scene: &Scene, sleeping: bool, iterations: Option<usize>, pool: Arc<ThreadPool>) -> RapierWorld {
+            let s = &scene.settings;
+            let mut w = PhysicsWorld { gravity: Vector::new(s.gravity[0], s.gravity[1], s.gravity[2]), ..Default::default() };
+            w.set_thread_pool(Some(pool));
+            w.integration_parameters.dt = s.dt;
+            if let Some(k) = iterations {
+                w.integration_parameters.num_solver_iterations = k.max(1);
+            }
+            let damping = |beta: f32| -((1.0 - beta as f64).ln() / s.dt as f64) as f32;
+            let material = |c: ColliderBuilder, friction: f32, restitution: f32| {
+                c.friction(friction)
+                    .friction_combine_rule(CoefficientCombineRule::GeometricMean)
+                    .restitution(restitution)
+                    .restitution_combine_rule(CoefficientCombineRule::Max)
+            };
+            if let Some(g) = &scene.ground {
+                let ground =
+                    ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Y)).translation(Vector::new(0.0, g.height, 0.0));
+                w.insert_collider(material(ground, s.friction, s.restitution), None);
+            }
+            let mut handles = Vec::with_capacity(scene.bodies.len());
+            for b in &scene.bodies {
+                let o = b.orientation;
+                let pose = Pose::from_parts(
+                    Vector::new(b.position[0], b.position[1], b.position[2]),
+                    Rotation::from_xyzw(o[0], o[1], o[2], o[3]).normalize(),
+                );
+                let body = if b.fixed { RigidBodyBuilder::fixed() } else { RigidBodyBuilder::dynamic() }
+                    .pose(pose)
+                    .linvel(Vector::new(b.linear_velocity[0], b.linear_velocity[1], b.linear_velocity[2]))
+                    .angvel(Vector::new(b.angular_velocity[0], b.angular_velocity[1], b.angular_velocity[2]))
+                    .linear_damping(damping(s.linear_damping))
+                    .angular_damping(damping(s.angular_damping))
+                    .can_sleep(sleeping);
+                let shape = match b.shape {
+                    Shape::Box { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
+                    Shape::Sphere { radius } => ColliderBuilder::ball(radius),
+                };
+                let collider =
+                    material(shape.mass(b.mass), b.friction.unwrap_or(s.friction), b.restitution.unwrap_or(s.restitution));
+                handles.push(w.insert(body, collider).0);
+            }
+            let mut anchor_body = None;
+            for j in &scene.joints {
+                let mut side = |k: usize| -> RigidBodyHandle {
+                    if j.bodies[k] >= 0 {
+                        handles[j.bodies[k] as usize]
+                    } else {
+                        *anchor_body.get_or_insert_with(|| w.insert_body(RigidBodyBuilder::fixed()))
+                    }
+                };
+                let (h1, h2) = (side(0), side(1));
+                let a = |k: usize| Vector::new(j.anchors[k][0], j.anchors[k][1], j.anchors[k][2]);
+                let joint = SphericalJointBuilder::new().local_anchor1(a(0)).local_anchor2(a(1)).contacts_enabled(false);
+                w.impulse_joints.insert(h1, h2, joint, true);
+            }
+            RapierWorld { world: w }
+        }
+
+        pub fn step(&mut self, steps: u64) {
+            for _ in 0..steps {
+                self.world.step();
+            }
+        }
+
+        pub fn num_solver_iterations(&self) -> usize {
+            self.world.integration_parameters.num_solver_iterations
+        }
+
+        /// Mean height of the dynamic bodies (m).
+        pub fn mean_height(&self) -> f64 {
+            crate::bench::mean_height(self.world.bodies.iter().filter(|(_, b)| b.is_dynamic()).map(|(_, b)| b.translation().y))
+        }
+    }
+}
+
+/// The peer as the report names it, and how our iterations compare with
+/// its, in words.
+pub fn peer_description(opts: &Options, settings: &verlet::Settings) -> (String, String) {
+    let ours = format!(
+        "ours: {} Jacobi sweeps per step in {} substeps by default (each case's own in its row), contacts found once per step",
+        settings.sweeps_per_step(),
+        settings.substeps
+    );
+    #[cfg(feature = "rapier")]
+    {
+        let k = opts.rapier_iterations.unwrap_or_else(|| rapier3d::prelude::IntegrationParameters::default().num_solver_iterations);
+        let threads = peer_threads(opts);
+        let name = format!(
+            "{} (its parallel pipeline in a rayon pool of {threads} thread{}, and of 1), sleeping {}, CCD off, \
+             num_solver_iterations = {k}{}",
+            rapier::ENGINE,
+            if threads == 1 { "" } else { "s" },
+            if opts.rapier_sleeping { "on" } else { "off" },
+            if opts.rapier_iterations.is_some() { "" } else { " (its default)" },
+        );
+        let its = format!(
+            "{ours}; rapier: num_solver_iterations = {k} (TGS-soft substeps, each 1 PGS velocity iteration + 1 stabilisation \
+             iteration, Gauss-Seidel), contacts found once per step"
+        );
+        (if opts.no_peer { "none (--no-peer)".into() } else { name }, its)
+    }
+    #[cfg(not(feature = "rapier"))]
+    {
+        let _ = opts;
+        ("none (built without --features rapier)".into(), ours)
+    }
+}
+
+/// Threads of the peer's parallel run: `--peer-threads`, else as many as
+/// lavapipe runs (`LP_NUM_THREADS` when it is a positive number; its
+/// default is the machine's cores), so that both engines have the same CPU.
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))]
+fn peer_threads(opts: &Options) -> usize {
+    let lavapipe = std::env::var("LP_NUM_THREADS").ok().and_then(|t| t.trim().parse::<usize>().ok()).filter(|&n| n > 0);
+    opts.peer_threads.or(lavapipe).unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// The peer's repetitions of one case (feature `rapier`), taken one at a
+/// time between ours: each a fresh rapier3d world of the same scene, its
+/// first step untimed, then the same steps timed; one in each pool.
+#[cfg(feature = "rapier")]
+pub struct PeerReps<'a> {
+    case: &'a Case,
+    scene: &'a Scene,
+    steps: u64,
+    reps: usize,
+    opts: &'a Options,
+    /// The `--peer-threads` pool's runs, then the one-thread pool's (none
+    /// when `--peer-threads` is 1: the first are its figures).
+    runs: Vec<PeerRun>,
+}
+
+/// One pool's repetitions of a case.
+#[cfg(feature = "rapier")]
+struct PeerRun {
+    threads: usize,
+    pool: Arc<rapier3d::rayon::ThreadPool>,
+    times: Vec<f64>,
+    setups: Vec<f64>,
+    /// The last repetition's solver iterations and mean height (its world
+    /// is dropped at once: ours are stepped and profiled meanwhile).
+    last: Option<(usize, f64)>,
+}
+
+#[cfg(feature = "rapier")]
+impl<'a> PeerReps<'a> {
+    /// None when the peer is not run (`--no-peer`, or more bodies than
+    /// `--peer-max-bodies`).
+    pub fn new(
+        case: &'a Case,
+        scene: &'a Scene,
+        steps: u64,
+        reps: usize,
+        opts: &'a Options,
+    ) -> Result<Option<PeerReps<'a>>, Error> {
+        if opts.no_peer || opts.peer_max_bodies.is_some_and(|m| scene.bodies.len() > m) {
+            return Ok(None);
+        }
+        let threads = peer_threads(opts);
+        let mut runs = Vec::new();
+        for n in if threads == 1 { vec![1] } else { vec![threads, 1] } {
+            let pool = rapier::pool(n).map_err(|e| Error::Input(format!("--peer-threads: no pool of {n} threads: {e}")))?;
+            runs.push(PeerRun { threads: n, pool, times: Vec::new(), setups: Vec::new(), last: None });
+        }
+        Ok(Some(PeerReps { case, scene, steps, reps, opts, runs }))
+    }
+
+    /// Repetition `r` (from 0) in each pool, the pools in turns (so that
+    /// neither always follows ours).
+    pub fn rep(&mut self, r: usize) {
+        let count = self.runs.len();
+        for k in 0..count {
+            let run = &mut self.runs[(k + r) % count];
+            let t = Instant::now();
+            let mut w =
+                rapier::RapierWorld::new(self.scene, self.opts.rapier_sleeping, self.opts.rapier_iterations, run.pool.clone());
+            w.step(1); // as ours: the first step untimed, the same steps timed
+            run.setups.push(t.elapsed().as_secs_f64());
+            let t = Instant::now();
+            w.step(self.steps);
+            let ms = t.elapsed().as_secs_f64() * 1e3 / self.steps as f64;
+            progress!("{}: rapier ({} threads) rep {}/{}: {ms:.3} ms/step", self.case.name, run.threads, r + 1, self.reps);
+            run.times.push(ms);
+            run.last = Some((w.num_solver_iterations(), w.mean_height()));
+        }
+    }
+
+    /// The peer's result against our median `ours_ms`.
+    pub fn result(self, ours_ms: f64) -> PeerResult {
+        let bodies = self.scene.bodies.len() as f64;
+        let one = self.runs.last().map_or_else(Vec::new, |r| r.times.clone());
+        let one_m = median(&one);
+        let run = self.runs.into_iter().next().expect("PeerReps::new makes a run");
+        let m = median(&run.times);
+        let (iterations, height) = run.last.unwrap_or((0, f64::NAN));
+        PeerResult {
+            engine: rapier::ENGINE.into(),
+            threads: run.threads.to_string(),
+            thread_count: run.threads,
+            sleeping: self.opts.rapier_sleeping,
+            num_solver_iterations: iterations,
+            setup_s: median(&run.setups),
+            ms_per_step: run.times,
+            median_ms_per_step: m,
+            body_steps_per_s: bodies / (m * 1e-3),
+            speedup: m / ours_ms,
+            mean_height: height,
+            one_thread_ms_per_step: one,
+            one_thread_median_ms_per_step: one_m,
+            one_thread_body_steps_per_s: bodies / (one_m * 1e-3),
+            one_thread_speedup: one_m / ours_ms,
+        }
+    }
+}
+
+/// Without the feature there is no peer: no value of this type exists.
+#[cfg(not(feature = "rapier"))]
+pub enum PeerReps {}
+
+#[cfg(not(feature = "rapier"))]
+impl PeerReps {
+    pub fn new(_: &Case, _: &Scene, _: u64, _: usize, _: &Options) -> Result<Option<PeerReps>, Error> {
+        Ok(None)
+    }
+
+    pub fn rep(&mut self, _: usize) {
+        match *self {}
+    }
+
+    pub fn result(self, _: f64) -> PeerResult {
+        match self {}
+    }
+}
