@@ -47,7 +47,8 @@ pub struct Case {
 }
 
 impl Case {
-    /// A named case (`CASES`) or `SCENE:COUNT` (`cubes:50000`, `pyramid:30`).
+    /// A named case (`CASES`) or `SCENE:COUNT` (`cubes:50000`, `pyramid:30`);
+    /// a bad one is an [`Error::Argument`] named `spec`.
     pub fn parse(spec: &str) -> Result<Case, Error> {
         if let Some(&(name, scene, count)) = CASES.iter().find(|c| c.0 == spec) {
             return Ok(Case { name: name.into(), scene: scene.into(), count });
@@ -58,18 +59,18 @@ impl Case {
                     .parse()
                     .ok()
                     .filter(|&n| n > 0)
-                    .ok_or_else(|| Error::Input(format!("--cases: {spec:?}: the count must be a positive integer")))?;
+                    .ok_or_else(|| case_error(format!("{spec:?}: the count must be a positive integer")))?;
                 (s, Some(n))
             }
             None => (spec, None),
         };
-        if !scenes::NAMES.iter().any(|(n, _)| *n == scene) {
+        if !scenes::NAMES.contains(&scene) {
             let named: Vec<&str> = CASES.iter().map(|c| c.0).collect();
-            let known: Vec<&str> = scenes::NAMES.iter().map(|c| c.0).collect();
-            let all: Vec<&str> = named.iter().chain(&known).copied().collect();
+            let known = scenes::NAMES;
+            let all: Vec<&str> = named.iter().chain(known).copied().collect();
             let guess = scenes::closest(spec, &all).map_or(String::new(), |g| format!(" (did you mean {g}?)"));
-            return Err(Error::Input(format!(
-                "--cases: unknown case {spec:?}{guess}; named cases: {}; or SCENE[:COUNT] with SCENE one of {}",
+            return Err(case_error(format!(
+                "unknown case {spec:?}{guess}; named cases: {}; or SCENE[:COUNT] with SCENE one of {}",
                 named.join(", "),
                 known.join(", ")
             )));
@@ -77,12 +78,12 @@ impl Case {
         // a count the scene takes no count of (`drop:5`) named a case of
         // one body "drop-5"
         if count.is_some() && scenes::default_count(scene).is_none() {
-            return Err(Error::Input(format!("--cases: {spec:?}: the {scene} scene takes no count; give {scene:?}")));
+            return Err(case_error(format!("{spec:?}: the {scene} scene takes no count; give {scene:?}")));
         }
         // the count is checked before anything is built (a case of a
         // billion boxes would take the machine's memory): any adapter's
         // bound here, the adapter's own in `run_case`
-        scenes::check(scene, count, scenes::MAX_BODIES).map_err(|e| Error::Input(format!("--cases: {spec:?}: {e}")))?;
+        scenes::check(scene, count, scenes::MAX_BODIES).map_err(|e| case_error(format!("{spec:?}: {e}")))?;
         let name = match count {
             Some(n) => format!("{scene}-{n}"),
             None => scene.to_string(),
@@ -249,4 +250,9 @@ mod tests {
         assert!(err.contains("the drop scene takes no count"), "{err}");
         assert_eq!(Case::parse("drop").unwrap().count, None);
     }
+}
+
+/// A case spec refused, naming the argument.
+fn case_error(reason: String) -> Error {
+    Error::Argument { name: "spec", reason }
 }

@@ -45,11 +45,26 @@ pub enum Error {
     /// A bad argument to the library or the command line.
     #[error("{0}")]
     Input(String),
+    /// A bad argument to a library call, named as the function names it
+    /// (the command line names its own flag instead, [`Error::for_flag`]).
+    #[error("{name}: {reason}")]
+    Argument { name: &'static str, reason: String },
     /// The simulation produced a non-finite number.
     #[error("simulation diverged: {0}")]
     Diverged(String),
     #[error("{path}: {source}")]
     Io { path: String, source: std::io::Error },
+}
+
+impl Error {
+    /// The same error with its argument named as the command line's `flag`
+    /// where it is an [`Error::Argument`] named `name`.
+    pub fn for_flag(self, name: &str, flag: &str) -> Error {
+        match self {
+            Error::Argument { name: n, reason } if n == name => Error::Input(format!("{flag}: {reason}")),
+            e => e,
+        }
+    }
 }
 
 /// The README's Rust example, compiled by `cargo test` as a doctest so that

@@ -83,25 +83,25 @@ impl Renderer {
     }
 
     /// As [`Renderer::new`], with options. Refuses a size of 0 or beyond the
-    /// device's `max_texture_dimension_2d`, naming the `--width`/`--height`
-    /// flag, before allocating anything.
+    /// device's `max_texture_dimension_2d` ([`Error::Argument`] naming
+    /// `width` or `height`), before allocating anything.
     pub fn with_options(gpu: &Gpu, scene: &Scene, width: u32, height: u32, options: RenderOptions) -> Result<Renderer, Error> {
         scene.validate()?;
         let max = gpu.limits.max_texture_dimension_2d;
-        for (flag, v) in [("--width", width), ("--height", height)] {
+        for (name, v) in [("width", width), ("height", height)] {
             if v == 0 || v > max {
-                return Err(Error::Input(format!(
-                    "{flag}: must be 1 to {max} pixels (this adapter's max_texture_dimension_2d), got {v}"
-                )));
+                let reason = format!("must be 1 to {max} pixels (this adapter's max_texture_dimension_2d), got {v}");
+                return Err(Error::Argument { name, reason });
             }
         }
         let readback_size = padded_row(width) as u64 * height as u64;
         if readback_size > gpu.limits.max_buffer_size {
-            return Err(Error::Input(format!(
-                "--width, --height: a {width} x {height} image needs a {readback_size}-byte readback buffer, \
-                 beyond this adapter's max_buffer_size of {}",
+            let reason = format!(
+                "a {width} x {height} image needs a {readback_size}-byte readback buffer, beyond this adapter's \
+                 max_buffer_size of {}",
                 gpu.limits.max_buffer_size
-            )));
+            );
+            return Err(Error::Argument { name: "width", reason });
         }
         let vertex_storage = gpu.adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE);
         if !vertex_storage || gpu.limits.max_storage_buffers_per_shader_stage < 3 {

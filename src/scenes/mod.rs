@@ -2,7 +2,7 @@
 //! the tests and the benchmarks: a name means one scene everywhere.
 //!
 //! [`SCENES`] has one row per scene (its name, how it is built, its default
-//! `--count`, its body count, its help line); every lookup by name below is
+//! `count`, its body count, its help line); every lookup by name below is
 //! read from it, so a scene is added in one place. The builders themselves
 //! are in `build.rs` (ours) and `box3d.rs` (Box3D's benchmarks).
 
@@ -18,14 +18,14 @@ use crate::scene::Scene;
 use crate::track::Track;
 use crate::Error;
 
-/// How a built-in scene is built from `--count` and `--seed`.
+/// How a built-in scene is built from `count` and `seed`.
 #[derive(Clone, Copy, Debug)]
 pub enum Build {
     /// Takes neither.
     Fixed(fn() -> Scene),
-    /// Takes `--count`.
+    /// Takes `count`.
     Counted(fn(usize) -> Scene),
-    /// Takes `--count` and `--seed`: a random scene.
+    /// Takes `count` and `seed`: a random scene.
     Seeded(fn(usize, u64) -> Scene),
 }
 
@@ -34,9 +34,9 @@ pub enum Build {
 pub struct BuiltIn {
     pub name: &'static str,
     pub build: Build,
-    /// The `--count` used when none is given; None for a scene that takes none.
+    /// The `count` used when none is given; None for a scene that takes none.
     pub default_count: Option<usize>,
-    /// The smallest `--count` it takes.
+    /// The smallest `count` it takes.
     pub min_count: usize,
     /// Its bodies at a count, worked out without building it; saturating,
     /// so any count is safe to ask about.
@@ -44,11 +44,18 @@ pub struct BuiltIn {
     /// The input track `verlet run --builtin NAME` plays unless `--input`
     /// gives another.
     pub track: Option<fn() -> Track>,
-    /// The line `verlet scene` prints for it.
+    /// A line on it, naming its parameters as `{count}` and `{seed}`
+    /// ([`BuiltIn::help_with`] names them).
     pub help: &'static str,
 }
 
 impl BuiltIn {
+    /// Its help line with its parameters called `count` and `seed` (the
+    /// command line passes its flags).
+    pub fn help_with(&self, count: &str, seed: &str) -> String {
+        self.help.replace("{count}", count).replace("{seed}", seed)
+    }
+
     const fn fixed(name: &'static str, build: fn() -> Scene, help: &'static str) -> BuiltIn {
         BuiltIn { name, build: Build::Fixed(build), default_count: None, min_count: 1, bodies: |_| 1, track: None, help }
     }
@@ -108,34 +115,34 @@ fn triangle(rows: u64) -> u64 {
 pub const SCENES: &[BuiltIn] = &[
     BuiltIn::fixed("drop", drop, "one unit box falling tilted from 3 m onto the ground"),
     BuiltIn::fixed("sphere", sphere, "one ball (restitution 0.8) dropped from 5 m"),
-    BuiltIn::seeded("cubes", cubes, 1000, |n| n, "--count random unit cubes falling side by side (--seed)"),
-    BuiltIn::seeded("pile", pile, 1000, |n| n, "--count random unit cubes dropped in four layers: they pile up (--seed)"),
-    BuiltIn::counted("stack", stack, 10, |n| n, "--count unit boxes in a column"),
-    BuiltIn::counted("pyramid", pyramid, 10, triangle, "--count rows of unit boxes"),
-    BuiltIn::counted("chain", chain, 21, |n| n, "--count links on ball joints, pinned at one end, laid out horizontally"),
+    BuiltIn::seeded("cubes", cubes, 1000, |n| n, "{count} random unit cubes falling side by side ({seed})"),
+    BuiltIn::seeded("pile", pile, 1000, |n| n, "{count} random unit cubes dropped in four layers: they pile up ({seed})"),
+    BuiltIn::counted("stack", stack, 10, |n| n, "{count} unit boxes in a column"),
+    BuiltIn::counted("pyramid", pyramid, 10, triangle, "{count} rows of unit boxes"),
+    BuiltIn::counted("chain", chain, 21, |n| n, "{count} links on ball joints, pinned at one end, laid out horizontally"),
     BuiltIn::counted(
         "hanging",
         hanging,
         20,
         |n| n.max(2),
-        "--count links on ball joints hung by both ends: settles into a catenary",
+        "{count} links on ball joints hung by both ends: settles into a catenary",
     )
     .at_least(2),
-    BuiltIn::counted("bridge", bridge, 20, |n| n.saturating_add(2), "--count planks on ball joints between two fixed posts"),
+    BuiltIn::counted("bridge", bridge, 20, |n| n.saturating_add(2), "{count} planks on ball joints between two fixed posts"),
     // a pile of 10 boxes, then 10 parts per ragdoll
     BuiltIn::counted(
         "ragdoll",
         ragdoll,
         10,
         |n| n.saturating_mul(10).saturating_add(10),
-        "--count ragdolls dropped onto a pile of boxes",
+        "{count} ragdolls dropped onto a pile of boxes",
     ),
     BuiltIn::counted(
         "blast",
         blast,
         10,
         |n| n.saturating_mul(6),
-        "a wall of --count x 6 boxes, blown apart at t = 1 s by its default input track",
+        "a wall of {count} x 6 boxes, blown apart at t = 1 s by its default input track",
     )
     .with_track(blast_track),
     // Box3D's benchmarks, at Box3D's sizes by default
@@ -144,21 +151,21 @@ pub const SCENES: &[BuiltIn] = &[
         large_pyramid,
         100,
         triangle,
-        "Box3D's benchmark: a pyramid of --count rows (100) of unit cubes touching side by side",
+        "Box3D's benchmark: a pyramid of {count} rows (100) of unit cubes touching side by side",
     ),
     BuiltIn::counted(
         "many_pyramids",
         many_pyramids,
         14,
         |n| n.saturating_mul(n).saturating_mul(SMALL_PYRAMID_BOXES as u64),
-        "Box3D's benchmark: --count x --count pyramids (14 x 14) of 10 rows of unit cubes",
+        "Box3D's benchmark: {count} x {count} pyramids (14 x 14) of 10 rows of unit cubes",
     ),
     BuiltIn::counted(
         "joint_grid",
         joint_grid,
         100,
         |n| n.saturating_mul(n),
-        "Box3D's benchmark: --count x --count balls (100 x 100) on ball joints, hung by the top row",
+        "Box3D's benchmark: {count} x {count} balls (100 x 100) on ball joints, hung by the top row",
     ),
 ];
 
@@ -167,13 +174,12 @@ pub fn find(name: &str) -> Option<&'static BuiltIn> {
     SCENES.iter().find(|s| s.name == name)
 }
 
-/// The names `verlet scene` knows, with a line on each: [`SCENES`]' names
-/// and help lines, as a constant.
-pub const NAMES: &[(&str, &str)] = &{
-    let mut names = [("", ""); SCENES.len()];
+/// The built-in scenes' names, in [`SCENES`]' order, as a constant.
+pub const NAMES: &[&str] = &{
+    let mut names = [""; SCENES.len()];
     let mut k = 0;
     while k < SCENES.len() {
-        names[k] = (SCENES[k].name, SCENES[k].help);
+        names[k] = SCENES[k].name;
         k += 1;
     }
     names
@@ -191,7 +197,7 @@ const RANDOM_COUNT: usize = {
     count
 };
 
-/// The built-in scenes that `--seed` changes: [`SCENES`]' random ones.
+/// The built-in scenes that `seed` changes: [`SCENES`]' random ones.
 pub const RANDOM: &[&str] = &{
     let mut names = [""; RANDOM_COUNT];
     let (mut k, mut at) = (0, 0);
@@ -215,7 +221,7 @@ pub const MAX_BODIES: u64 = 1 << 20;
 // The file size limit allows 1 KiB a body for as many bodies as this.
 const _: () = assert!(crate::load_error::MAX_FILE_BYTES == 1024 * MAX_BODIES);
 
-/// The default `--count` of a scene that takes one; None for one that
+/// The default `count` of a scene that takes one; None for one that
 /// takes none (`drop`, `sphere`) or an unknown name.
 pub fn default_count(name: &str) -> Option<usize> {
     find(name)?.default_count
@@ -233,10 +239,10 @@ pub fn default_track(name: &str) -> Option<Track> {
     Some((find(name)?.track?)())
 }
 
-/// Checks a built-in scene's name and `--count` before anything is built:
+/// Checks a built-in scene's name and `count` before anything is built:
 /// the name is known, the count is one the scene takes (at least 1; 2 for
 /// `hanging`), and the scene has at most `max_bodies` bodies (and
-/// [`MAX_BODIES`]). Returns the scene's body count. Errors name `--count`.
+/// [`MAX_BODIES`]). Returns the scene's body count. A bad count is an [`Error::Argument`] named `count`.
 pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, Error> {
     let Some(scene) = find(name) else {
         let names: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
@@ -247,13 +253,13 @@ pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, E
     if let Some(count) = count {
         let min = scene.min_count;
         if scene.default_count.is_some() && count < min {
-            return Err(Error::Input(format!("--count: the {name} scene takes at least {min}, got {count}")));
+            return Err(Error::Argument { name: "count", reason: format!("the {name} scene takes at least {min}, got {count}") });
         }
     }
     let max = max_bodies.min(MAX_BODIES);
     if bodies > max {
         let what = match count {
-            Some(count) => format!("--count {count}"),
+            Some(count) => format!("a count of {count}"),
             None => "its default count".to_string(),
         };
         let limit = if max < MAX_BODIES {
@@ -264,7 +270,10 @@ pub fn check(name: &str, count: Option<usize>, max_bodies: u64) -> Result<u64, E
         // a count the sum saturated on has no honest figure (a pyramid of
         // 4294967297 rows read as 9223372036854775807 bodies)
         let has = if bodies >= u64::MAX / 4 { format!("more than {max} bodies") } else { format!("{bodies} bodies") };
-        return Err(Error::Capacity(format!("--count: the {name} scene with {what} has {has}, but {limit}")));
+        return Err(Error::Argument {
+            name: "count",
+            reason: format!("the {name} scene with {what} is too large: it has {has}, but {limit}"),
+        });
     }
     Ok(bodies)
 }
@@ -323,7 +332,7 @@ mod tests {
 
     #[test]
     fn a_mistyped_name_finds_the_one_meant() {
-        let names: Vec<&str> = super::NAMES.iter().map(|(n, _)| *n).collect();
+        let names: Vec<&str> = super::NAMES.to_vec();
         assert_eq!(closest("pyramd", &names), Some("pyramid"));
         assert_eq!(closest("Stakc", &names), Some("stack"));
         assert_eq!(closest("ragdol", &names), Some("ragdoll"));
@@ -334,7 +343,7 @@ mod tests {
     #[test]
     fn the_derived_lists_follow_the_table() {
         let names: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
-        assert_eq!(NAMES.iter().map(|(n, _)| *n).collect::<Vec<_>>(), names);
+        assert_eq!(NAMES.to_vec(), names);
         assert_eq!(RANDOM, ["cubes", "pile"]);
         let mut unique = names.clone();
         unique.sort();

@@ -127,7 +127,7 @@ fn huge_counts_are_refused_before_anything_is_built() {
 
 #[test]
 fn body_counts_are_worked_out_exactly_without_building() {
-    for &(name, _) in scenes::NAMES {
+    for &name in scenes::NAMES {
         for count in [None, Some(1), Some(2), Some(3), Some(7), Some(30)] {
             let Some(scene) = scenes::by_name(name, count, 1) else { panic!("{name}") };
             assert_eq!(scenes::body_count(name, count), Some(scene.bodies.len() as u64), "{name} {count:?}");
@@ -160,7 +160,7 @@ fn built_in_scenes_refuse_counts_they_cannot_make() {
         assert_refused_quickly(args, &[wanted]);
     }
     // what `verlet scene` prints, `verlet run` takes: every scene at its smallest count loads
-    for &(name, _) in scenes::NAMES {
+    for &name in scenes::NAMES {
         let (out, _) = capped(&["scene", name, "--count", if name == "hanging" { "2" } else { "1" }]);
         assert!(out.status.success(), "{name}: {}", stderr(&out));
         Scene::from_json_str(&String::from_utf8_lossy(&out.stdout)).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -961,10 +961,11 @@ fn help_lists_every_built_in_scene() {
         let (out, took) = capped(args);
         let help = String::from_utf8_lossy(&out.stdout);
         assert!(out.status.success(), "{args:?}: {}", stderr(&out));
-        for (name, what) in scenes::NAMES {
+        for scene in scenes::SCENES {
+            let (name, what) = (scene.name, scene.help_with("--count", "--seed"));
             let line = help.lines().find(|l| l.split_whitespace().next() == Some(name));
             let line = line.unwrap_or_else(|| panic!("{args:?}: no line for the {name} scene in {help}"));
-            assert!(line.contains(what), "{args:?}: {line:?} lacks {what:?}");
+            assert!(line.contains(&what), "{args:?}: {line:?} lacks {what:?}");
         }
         assert!(took < QUICK, "{args:?}: took {took:?}");
     }

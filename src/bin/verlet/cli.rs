@@ -186,13 +186,13 @@ pub fn parse() -> Result<Cli, clap::Error> {
     Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))
 }
 
-/// The built-in scenes, a line each, from `scenes::NAMES` (so a scene added
+/// The built-in scenes, a line each, from `scenes::SCENES` (so a scene added
 /// there is listed without touching the help).
 fn scene_list() -> String {
-    let width = scenes::NAMES.iter().map(|(name, _)| name.len()).max().unwrap_or(0);
+    let width = scenes::SCENES.iter().map(|s| s.name.len()).max().unwrap_or(0);
     let mut list = String::from("Built-in scenes (`verlet scene NAME`, `verlet run --builtin NAME`):");
-    for (name, what) in scenes::NAMES {
-        list.push_str(&format!("\n  {name:<width$}  {what}"));
+    for s in scenes::SCENES {
+        list.push_str(&format!("\n  {:<width$}  {}", s.name, s.help_with("--count", "--seed")));
     }
     list
 }

@@ -153,7 +153,14 @@ impl Recorder {
     /// the run succeeds.
     pub fn open(args: &RunArgs, gpu: &Gpu, scene: &Scene) -> Result<Recorder, Error> {
         let wants_images = args.frames.is_some() || args.gif.is_some() || args.contact_sheet.is_some();
-        let renderer = if wants_images { Some(Renderer::new(gpu, scene, args.width, args.height)?) } else { None };
+        let renderer = if wants_images {
+            Some(
+                Renderer::new(gpu, scene, args.width, args.height)
+                    .map_err(|e| e.for_flag("width", "--width").for_flag("height", "--height"))?,
+            )
+        } else {
+            None
+        };
         if let Some(dir) = &args.frames {
             std::fs::create_dir_all(dir)
                 .map_err(|e| Error::Input(format!("--frames: cannot create directory {}: {e}", dir.display())))?;

@@ -130,7 +130,7 @@ fn first_look(args: &RunArgs) -> Result<(Option<Scene>, u64), Error> {
         (None, Some(name)) => {
             scene::warn_unused_count(name, args.count);
             scene::warn_unused_seed(name, args.seed);
-            Ok((None, scenes::check(name, args.count, scenes::MAX_BODIES)?))
+            Ok((None, scenes::check(name, args.count, scenes::MAX_BODIES).map_err(scene::count_flag)?))
         }
         (None, None) => Err(Error::Input(format!("missing a scene: give a scene file or --builtin NAME; {RUN_USAGE}"))),
     }
@@ -179,7 +179,7 @@ fn build_builtin(args: &RunArgs, gpu: &Gpu) -> Result<Scene, Error> {
         return Err(Error::Input(format!("missing a scene: give a scene file or --builtin NAME; {RUN_USAGE}")));
     };
     let seed = args.seed.unwrap_or(scene::DEFAULT_SEED);
-    let mut scene = scenes::checked(name, args.count, seed, verlet::world::max_bodies(gpu))?;
+    let mut scene = scenes::checked(name, args.count, seed, verlet::world::max_bodies(gpu)).map_err(scene::count_flag)?;
     with_dt(&mut scene, args.dt)?;
     Ok(scene)
 }

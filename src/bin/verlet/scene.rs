@@ -23,9 +23,14 @@ pub fn warn_unused_count(name: &str, count: Option<usize>) {
 /// Prints the built-in scene `name` as JSON.
 pub fn print(name: &str, count: Option<usize>, seed: Option<u64>) -> Result<(), Error> {
     // bounded before it is built: any adapter's limit (`verlet run` checks this one's)
-    let scene = scenes::checked(name, count, seed.unwrap_or(DEFAULT_SEED), scenes::MAX_BODIES)?;
+    let scene = scenes::checked(name, count, seed.unwrap_or(DEFAULT_SEED), scenes::MAX_BODIES).map_err(count_flag)?;
     warn_unused_count(name, count);
     warn_unused_seed(name, seed);
     outln!("{}", scene.to_json())?;
     Ok(())
+}
+
+/// A built-in scene's `count` refused, named as the `--count` flag.
+pub fn count_flag(e: Error) -> Error {
+    e.for_flag("count", "--count")
 }

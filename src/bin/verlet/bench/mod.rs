@@ -308,7 +308,7 @@ fn cases(opts: &Options) -> Result<Vec<Case>, Error> {
     if blanks > 0 && !opts.cases.is_empty() {
         progress!("warning: --cases: {blanks} empty name(s) between commas skipped");
     }
-    specs.iter().map(|s| Case::parse(s)).collect()
+    specs.iter().map(|s| Case::parse(s).map_err(|e| e.for_flag("spec", "--cases"))).collect()
 }
 
 fn median(v: &[f64]) -> f64 {
