@@ -12,8 +12,9 @@
 // a NaN in pos, disp, rot or prev_rot), lies farther than MAX_DISTANCE
 // from the origin, moved faster than MAX_SPEED or turned faster than MAX_SPIN
 // (or more than MAX_TURN) over the last substep is
-// flagged in status[2..4] (bindings.wgsl: the lowest such body of the first
-// step that found any, with that step's index) and stopped: it is parked at
+// flagged in status[STATUS_FAULT] and status[STATUS_FAULT_STEP] (the lowest
+// such body of the first step that found any, with that step's index) and
+// stopped: it is parked at
 // rest at its last sane pose (its current one if that is finite and within
 // MAX_DISTANCE, else its previous one, pos - disp, which passed this check
 // last time unless an input wrote it, else its current one with each
@@ -55,7 +56,7 @@ fn wakes_next(i: u32, s: BodyState) -> u32 {
     return select(s.pos_low & WAKES, select(0u, WAKES, (now & WOKEN_NOW) != 0u), first);
 }
 
-// Notes that a body moves, or is due to wake, after the step (status[15]:
+// Notes that a body moves, or is due to wake, after the step (status[STATUS_MOVING]:
 // the world is at rest after a step that noted none), in the step's last
 // substep: a body that fell asleep in an earlier one holds still from then
 // on. Loaded first, so that after the first store of a step the other
@@ -63,8 +64,8 @@ fn wakes_next(i: u32, s: BodyState) -> u32 {
 // 10k, an atomic being a loop over the lanes on lavapipe); the substep
 // enters the condition by a select, beside the load (see above).
 fn moved() {
-    if (atomicLoad(&status[15]) < select(0u, 1u, params.substep + 1u == params.substeps)) {
-        atomicStore(&status[15], 1u);
+    if (atomicLoad(&status[STATUS_MOVING]) < select(0u, 1u, params.substep + 1u == params.substeps)) {
+        atomicStore(&status[STATUS_MOVING], 1u);
     }
 }
 
@@ -73,8 +74,8 @@ fn moved() {
 // smaller one the other way), so a spin is also absurd where it turns more
 // than MAX_TURN in one substep, whatever MAX_SPIN allows.
 // MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN (m, m/s, rad/s, rad per
-// substep), NO_FAULT (status[3] and status[2] before any fault) and what was
-// wrong, in the low three bits of status[2] (8 * body + FAULT_*):
+// substep), NO_FAULT (status[STATUS_FAULT_STEP] and status[STATUS_FAULT] before any fault) and what was
+// wrong, in the low three bits of status[STATUS_FAULT] (8 * body + FAULT_*):
 // FAULT_NON_FINITE, FAULT_FAR, FAULT_FAST, FAULT_SPIN, FAULT_ENERGY; shared
 // with Rust (src/world.rs), which decodes them.
 //
@@ -125,12 +126,12 @@ fn fault_of(s: BodyState, p: BodyProps) -> u32 {
 
 // Records a fault of body i unless an earlier step already recorded one:
 // within one dispatch every thread has the same step_index, and dispatches
-// run in order, so status[2] and status[3] always describe the same event.
+// run in order, so status[STATUS_FAULT] and status[STATUS_FAULT_STEP] always describe the same event.
 fn report_fault(i: u32, fault: u32) {
-    let first = atomicLoad(&status[3]);
+    let first = atomicLoad(&status[STATUS_FAULT_STEP]);
     if (first == NO_FAULT || first == params.step_index) {
-        atomicMin(&status[3], params.step_index);
-        atomicMin(&status[2], 8u * i + fault);
+        atomicMin(&status[STATUS_FAULT_STEP], params.step_index);
+        atomicMin(&status[STATUS_FAULT], 8u * i + fault);
     }
 }
 

@@ -134,7 +134,7 @@ var<private> owned: u32;
 // LOOP_TRIPS (lavapipe: 65535, counted over the invocations it runs side
 // by side), a long walk may have been cut short, silently: a fast body's
 // walk over a grid of about 65 000 bodies or more. `note_long_walks` says
-// so in status[20].
+// so in status[STATUS_WALKS_CUT].
 var<private> trips: u32;
 
 // Partners each body's scratch room holds: body_pairs shared out by grid
@@ -286,7 +286,7 @@ fn walk(i: u32) {
     let rings = select(1u, rings_of(size), walker.fast);
     let side = 2u * rings + 1u;
     let ahead = (side * side * side - 1u) / 2u;
-    let both = walker.fast || (walker.moves && atomicLoad(&status[11]) != 0u);
+    let both = walker.fast || (walker.moves && atomicLoad(&status[STATUS_GRID_SLEEPS]) != 0u);
     var cells = select(select(1u + ahead, 1u + 2u * ahead, both), 0u, sleeps || !grid);
     let cube = f32(side) * f32(side) * f32(side);
     let every = walker.fast && (cube >= f32(params.hash_size) || 2.0 * cube >= f32(cell_start[params.hash_size]));
@@ -342,7 +342,7 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
 // whatever the order).
 var<workgroup> group_trips: atomic<u32>;
 
-// Sets status[20] if a walk of the workgroup may have been cut short.
+// Sets status[STATUS_WALKS_CUT] if a walk of the workgroup may have been cut short.
 // Lavapipe runs 8 invocations side by side (a vector) and counts a loop's
 // trips once for them all, as many as the longest takes; nested loops and
 // loops one after the other add up. So the trips a vector's loops take
@@ -354,7 +354,7 @@ var<workgroup> group_trips: atomic<u32>;
 // sum so far: the last to add tests the whole sum, whatever the order.
 fn note_long_walks() {
     if (atomicAdd(&group_trips, trips) + trips >= LOOP_TRIPS) {
-        atomicStore(&status[20], 1u);
+        atomicStore(&status[STATUS_WALKS_CUT], 1u);
     }
 }
 

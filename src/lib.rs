@@ -17,6 +17,7 @@
 
 pub mod bench;
 pub mod gpu;
+pub mod limits;
 pub mod load_error;
 pub mod output;
 pub mod reference;
