@@ -39,18 +39,15 @@ pub(super) struct PoolWatch {
 }
 
 impl World {
-    /// Grows the pair list and the manifold pool, before the next step, to
-    /// 1.5 times the most a step used once a step has used more than three
-    /// quarters of either (a blocking readback of the status record after
-    /// every batch of `steps` steps). Both are rebuilt every step, so
-    /// nothing is carried over. Returns whether a step of the last batch
-    /// wanted more than a pool held and the pool has grown: which pairs or
-    /// manifolds then found no room depended on thread timing, so the
-    /// caller takes the batch again. A pool already at its limit
-    /// (`pair_capacities`) stays, and its overflow is reported by
-    /// `contact_report`. Otherwise the batch stands: its wants are added to
-    /// `pools`, which may mark a pool to shrink (`SHRINK_AFTER_STEPS`), and
-    /// the GPU's maxima are cleared for the next.
+    /// After a batch of `steps` steps (a blocking readback of the status
+    /// record): grows a pool that a step filled past three quarters to 1.5
+    /// times the most a step used. Returns whether the batch must be taken
+    /// again: a step wanted more than a pool held and the pool has grown
+    /// (which contacts found room depended on thread timing). A pool at its
+    /// limit (`pair_capacities`) stays, its overflow reported by
+    /// `contact_report`. Otherwise the batch stands: its wants go to
+    /// `pools`, which may mark a pool to shrink, and the GPU's maxima are
+    /// cleared for the next batch.
     pub(super) fn fit_pools(&mut self, steps: usize) -> Result<bool, Error> {
         let status = self.read_status()?;
         let report = self.batch_report_of(&status);
