@@ -31,30 +31,9 @@
 @group(0) @binding(21) var<storage, read_write> snaps_1: array<SnapWords>;
 @group(0) @binding(15) var<storage, read_write> pair_meta: array<PairMeta>;     // body_count + 1
 @group(0) @binding(16) var<storage, read_write> body_pairs: array<u32>;         // 2 x pair capacity
-// status[0]: candidate pairs wanted this step, status[1]: most in any step;
-// status[4]: manifolds used this step, status[5]: most in any step (a pool
-// too small when either exceeds its capacity); status[6]: of them, the face
-// contacts left for narrowphase_clip (taken from the top of the pool),
-// status[7]: the others (taken from the bottom); status[2], status[3]: the
-// first numerical fault (see integrate.wgsl): 8 * body + FAULT_* of the
-// lowest body found bad in the first step that found any, and that step's
-// step_index, both atomicMin-ed from NO_FAULT (0xffffffff, written when the
-// buffer is made); status[8..11]: the narrowphase's indirect dispatch
-// (workgroups over the pairs in rows, rows, 1: write_dispatch), copied out
-// before it runs;
-// status[11]: 1 if a grid body sleeps this step (grid_count sets it,
-// contact_lists clears it: the pair walks read it, see pairs.wgsl);
-// status[12..15]: the contact passes' (over the manifolds, in rows alike),
-// written by contact_lists and copied out after it; status[15]: 1 if a
-// body moves or is due to wake after the step (integrate sets it, grid_count
-// clears it: with 0 after a batch the world is at rest, and the host skips
-// its steps until an input, see World::at_rest); status[16]: how many
-// bodies the step's body passes run over (`listed_body`);
-// status[17..20]: their indirect dispatch (workgroups over them, 1, 1),
-// counted by contact_lists and copied out after it; status[20]: 1 once a
-// pair walk took so many loop trips that the driver may have cut it short
-// (LOOP_TRIPS, see pairs.wgsl), never cleared; status[21]: the same for a
-// contact list's sort (contact_lists, narrowphase.wgsl); 22 words
+// The status record (`Status` in src/gpu/status.rs, which says what each
+// word holds): counters, maxima, the first fault and the indirect
+// dispatches' sizes, indexed by the STATUS_* word constants written from it.
 @group(0) @binding(12) var<storage, read_write> status: array<atomic<u32>>;
 
 // The most trips an invocation's loops may take, summed (`Gpu::loop_trips`):
@@ -149,7 +128,7 @@ fn set_rest_time(i: u32, rest: f32) {
 
 // The body that invocation k of a body pass (integrate, solve,
 // restitution) works on, or NONE: the k-th body contact_lists listed this
-// step, in sorted[body_count ..] (status[16] of them; pairs_count fills the
+// step, in sorted[body_count ..] (status[STATUS_LISTED] of them; pairs_count fills the
 // rest of the run with NONE, so no invocation loads the atomic count). Every
 // body is listed but a sleeper the step leaves as it is (`sleeps_held`), whose
 // pose is the same in both state buffers, so a resting pile pays these passes
@@ -160,12 +139,12 @@ fn listed_body(k: u32) -> u32 {
 
 // Lists body i for the body passes (contact_lists, see `listed_body`): at
 // the next place of sorted's second half, counting one more workgroup of
-// their indirect dispatch (status[17]) with each place that starts one.
+// their indirect dispatch (status[STATUS_LISTED_DISPATCH]) with each place that starts one.
 fn list_body(i: u32) {
-    let k = atomicAdd(&status[16], 1u);
+    let k = atomicAdd(&status[STATUS_LISTED], 1u);
     sorted[params.body_count + k] = i;
     if (k % WORKGROUP == 0u) {
-        atomicAdd(&status[17], 1u);
+        atomicAdd(&status[STATUS_LISTED_DISPATCH], 1u);
     }
 }
 
@@ -179,14 +158,15 @@ fn large_body(k: u32) -> u32 {
 // pairs need several rows (y) of at most this many workgroups (x).
 override DISPATCH_ROW: u32 = 65535u;
 
-// Writes the indirect dispatch of `count` invocations at status[at ..
-// at + 3]: as few rows as hold them, of equal length.
+// Writes the indirect dispatch of `count` invocations into the three status
+// words from `at` (a `*_DISPATCH` triple: x, then DISPATCH_Y, DISPATCH_Z):
+// as few rows as hold them, of equal length.
 fn write_dispatch(at: u32, count: u32) {
     let groups = (count + WORKGROUP - 1u) / WORKGROUP;
     let rows = max((groups + DISPATCH_ROW - 1u) / DISPATCH_ROW, 1u);
     atomicStore(&status[at], (groups + rows - 1u) / rows);
-    atomicStore(&status[at + 1u], rows);
-    atomicStore(&status[at + 2u], 1u);
+    atomicStore(&status[at + DISPATCH_Y], rows);
+    atomicStore(&status[at + DISPATCH_Z], 1u);
 }
 
 // The invocation's place in a dispatch that write_dispatch sized.
@@ -194,15 +174,15 @@ fn dispatch_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
     return gid.x + gid.y * groups.x * WORKGROUP;
 }
 
-// The manifolds this step's narrowphase stored (status[4], within the pool).
+// The manifolds this step's narrowphase stored (status[STATUS_MANIFOLDS], within the pool).
 fn manifolds_used() -> u32 {
-    return min(atomicLoad(&status[4]), arrayLength(&manifolds));
+    return min(atomicLoad(&status[STATUS_MANIFOLDS]), arrayLength(&manifolds));
 }
 
 // The slot of the k-th stored manifold (k < used): the pool fills from both
 // ends (new_manifold in narrowphase.wgsl), the face contacts to clip at the top.
 fn pool_slot(k: u32, used: u32) -> u32 {
-    let top = min(atomicLoad(&status[6]), arrayLength(&manifolds));
+    let top = min(atomicLoad(&status[STATUS_MANIFOLDS_TOP]), arrayLength(&manifolds));
     let bottom = used - top;
     return select(k, arrayLength(&manifolds) - top + (k - bottom), k >= bottom);
 }

@@ -104,13 +104,13 @@ fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i == 0u) {
-        atomicStore(&status[4], 0u);
-        atomicStore(&status[6], 0u);
-        atomicStore(&status[7], 0u);
-        atomicStore(&status[15], 0u);
+        atomicStore(&status[STATUS_MANIFOLDS], 0u);
+        atomicStore(&status[STATUS_MANIFOLDS_TOP], 0u);
+        atomicStore(&status[STATUS_MANIFOLDS_BOTTOM], 0u);
+        atomicStore(&status[STATUS_MOVING], 0u);
         // contact_lists lists the bodies and counts their workgroups
-        atomicStore(&status[16], 0u);
-        atomicStore(&status[17], 0u);
+        atomicStore(&status[STATUS_LISTED], 0u);
+        atomicStore(&status[STATUS_LISTED_DISPATCH], 0u);
     }
     if (i >= params.body_count) {
         return;
@@ -133,8 +133,8 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     // the movers' walks look for sleepers behind them too; one store sets it
-    if (sleeps && atomicLoad(&status[11]) == 0u) {
-        atomicStore(&status[11], 1u);
+    if (sleeps && atomicLoad(&status[STATUS_GRID_SLEEPS]) == 0u) {
+        atomicStore(&status[STATUS_GRID_SLEEPS], 1u);
     }
     atomicAdd(&cell_count[bucket_of(cell_of(s.pos))], 1u);
 }
@@ -228,9 +228,9 @@ fn finish_scan(sum: vec2<u32>) {
     if (SCAN_PAIRS) {
         // the narrowphase runs over the pairs that fit the list
         let listed = min(sum.x, arrayLength(&pairs));
-        atomicStore(&status[0], sum.x);
-        atomicMax(&status[1], sum.x);
-        write_dispatch(8u, listed);
+        atomicStore(&status[STATUS_PAIRS], sum.x);
+        atomicMax(&status[STATUS_PAIRS_MAX], sum.x);
+        write_dispatch(STATUS_PAIRS_DISPATCH, listed);
     }
 }
 

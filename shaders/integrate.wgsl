@@ -7,7 +7,7 @@
 // Numerical faults: every substep, with no readback, a body whose pose is not
 // finite, lies beyond MAX_DISTANCE, or moved or turned faster than MAX_SPEED,
 // MAX_SPIN or MAX_TURN (or its speed_limit) over the last substep is
-// flagged in status[2..4] (bindings.wgsl: the lowest such body of the first
+// flagged in status[STATUS_FAULT] and status[STATUS_FAULT_STEP] (bindings.wgsl: the lowest such body of the first
 // step that found any, with that step's index) and parked at rest at its last
 // sane pose; the step goes on. A run with no fault is bit-identical to one
 // without the check, and the host reads the flag only on request.
@@ -27,24 +27,21 @@ fn wakes_next(i: u32, s: BodyState) -> u32 {
     return select(s.pos_low & WAKES, select(0u, WAKES, (now & WOKEN_NOW) != 0u), first);
 }
 
-// Notes that a body moves, or is due to wake, after the step (status[15]:
+// Notes that a body moves, or is due to wake, after the step (status[STATUS_MOVING]:
 // the world is at rest after a step that noted none), in the step's last
 // substep. Loaded before stored, so only the first store of a step writes (an
 // atomic is a loop over the lanes on lavapipe).
 fn moved() {
-    if (atomicLoad(&status[15]) < select(0u, 1u, params.substep + 1u == params.substeps)) {
-        atomicStore(&status[15], 1u);
+    if (atomicLoad(&status[STATUS_MOVING]) < select(0u, 1u, params.substep + 1u == params.substeps)) {
+        atomicStore(&status[STATUS_MOVING], 1u);
     }
 }
 
-// Beyond these a body is absurd; shared with Rust (src/world.rs), which
-// decodes the faults. A pose pair holds less than half a turn, so MAX_TURN
-// bounds a spin whatever MAX_SPIN allows.
-
-// MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN (m, m/s, rad/s, rad per
-// substep), NO_FAULT (status[3] and status[2] before any fault) and what was
-// wrong, in the low three bits of status[2] (8 * body + FAULT_*):
-// FAULT_NON_FINITE, FAULT_FAR, FAULT_FAST, FAULT_SPIN, FAULT_ENERGY.
+// Beyond MAX_DISTANCE, MAX_SPEED, MAX_SPIN and MAX_TURN (m, m/s, rad/s, rad
+// per substep; src/limits.rs, which decodes the faults) a body is absurd. A
+// pose pair holds less than half a turn, so MAX_TURN bounds a spin whatever
+// MAX_SPIN allows. A fault is stored as 8 * body + FAULT_* in
+// status[STATUS_FAULT], its step in status[STATUS_FAULT_STEP] (NO_FAULT in both before any).
 
 // FAULT_ENERGY: faster than all the scene's energy could move this body alone
 // (BodyProps' speed_limit), which only the solver can do; checked while
@@ -85,12 +82,12 @@ fn fault_of(s: BodyState, p: BodyProps) -> u32 {
 
 // Records a fault of body i unless an earlier step already recorded one:
 // within one dispatch every thread has the same step_index, and dispatches
-// run in order, so status[2] and status[3] always describe the same event.
+// run in order, so status[STATUS_FAULT] and status[STATUS_FAULT_STEP] always describe the same event.
 fn report_fault(i: u32, fault: u32) {
-    let first = atomicLoad(&status[3]);
+    let first = atomicLoad(&status[STATUS_FAULT_STEP]);
     if (first == NO_FAULT || first == params.step_index) {
-        atomicMin(&status[3], params.step_index);
-        atomicMin(&status[2], 8u * i + fault);
+        atomicMin(&status[STATUS_FAULT_STEP], params.step_index);
+        atomicMin(&status[STATUS_FAULT], 8u * i + fault);
     }
 }
 

@@ -113,22 +113,22 @@ fn store_manifold(slot: u32, a: u32, b: u32, pair: u32, m: Manifold) {
 
 // A slot of the manifold pool for bodies a and b (b may be GROUND), listed
 // in both bodies' lists (in the order the slots are taken; contact_lists
-// sorts them), or NONE when the pool is full (counted in status[4] all the
-// same, so the host grows it; contact_lists keeps the most in status[5]).
+// sorts them), or NONE when the pool is full (counted in status[STATUS_MANIFOLDS] all the
+// same, so the host grows it; contact_lists keeps the most in status[STATUS_MANIFOLDS_MAX]).
 // A face contact left for clipping (`to_clip`) takes the next slot from the
 // top of the pool, any other the next from the bottom, so narrowphase_clip
-// runs over the top run alone; the two never meet, as status[4] hands out
+// runs over the top run alone; the two never meet, as status[STATUS_MANIFOLDS] hands out
 // no more tickets than the pool has slots.
 fn new_manifold(a: u32, b: u32, to_clip: bool) -> u32 {
-    let ticket = atomicAdd(&status[4], 1u);
+    let ticket = atomicAdd(&status[STATUS_MANIFOLDS], 1u);
     if (ticket >= arrayLength(&manifolds)) {
         return NONE;
     }
     var slot: u32;
     if (to_clip) {
-        slot = arrayLength(&manifolds) - 1u - atomicAdd(&status[6], 1u);
+        slot = arrayLength(&manifolds) - 1u - atomicAdd(&status[STATUS_MANIFOLDS_TOP], 1u);
     } else {
-        slot = atomicAdd(&status[7], 1u);
+        slot = atomicAdd(&status[STATUS_MANIFOLDS_BOTTOM], 1u);
     }
     list_contact(a, contact_ref(slot, false));
     if (b != GROUND) {
@@ -159,7 +159,7 @@ fn joined(a: u32, b: u32) -> bool {
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let p = dispatch_index(gid, groups);
-    if (p >= min(atomicLoad(&status[0]), arrayLength(&pairs))) {
+    if (p >= min(atomicLoad(&status[STATUS_PAIRS]), arrayLength(&pairs))) {
         return;
     }
     let pr = pairs[p];
@@ -210,7 +210,7 @@ fn narrowphase_ground(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let p = pair_meta[i].owned_start;
-    if (pair_meta[i].owned == 0u || p >= min(atomicLoad(&status[0]), arrayLength(&pairs)) || pairs[p].b != GROUND) {
+    if (pair_meta[i].owned == 0u || p >= min(atomicLoad(&status[STATUS_PAIRS]), arrayLength(&pairs)) || pairs[p].b != GROUND) {
         return;
     }
     let m = ground_manifold(i, CONTACT_MARGIN + pair_meta[i].reach);
@@ -229,7 +229,7 @@ fn narrowphase_ground(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(WORKGROUP)
 fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let nth = dispatch_index(gid, groups);
-    if (nth >= min(atomicLoad(&status[6]), manifolds_used())) {
+    if (nth >= min(atomicLoad(&status[STATUS_MANIFOLDS_TOP]), manifolds_used())) {
         return;
     }
     let k = arrayLength(&manifolds) - 1u - nth;
@@ -250,17 +250,17 @@ fn narrowphase_clip(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
 // that stays (`held`) and the normal pushes' split (`normal_split`), and lists
 // the body for the body passes. Invocation 0 also writes the contact passes'
 // indirect dispatch, over the manifolds
-// the pool holds (status[12..15]).
+// the pool holds (status[STATUS_MANIFOLDS_DISPATCH]).
 @compute @workgroup_size(WORKGROUP)
 fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i == 0u) {
-        // the most manifolds any step wanted (status[4] counts the slots
+        // the most manifolds any step wanted (status[STATUS_MANIFOLDS] counts the slots
         // the pool could not give too)
-        atomicMax(&status[5], atomicLoad(&status[4]));
-        write_dispatch(12u, manifolds_used());
+        atomicMax(&status[STATUS_MANIFOLDS_MAX], atomicLoad(&status[STATUS_MANIFOLDS]));
+        write_dispatch(STATUS_MANIFOLDS_DISPATCH, manifolds_used());
         // the pair walks are done: grid_count sets it again next step
-        atomicStore(&status[11], 0u);
+        atomicStore(&status[STATUS_GRID_SLEEPS], 0u);
     }
     if (i >= params.body_count) {
         return;
@@ -307,14 +307,14 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
 // `trips` in pairs.wgsl).
 var<private> list_trips: u32;
 
-// Sets status[21] if this body's sort may have been cut short: a list
+// Sets status[STATUS_LISTS_CUT] if this body's sort may have been cut short: a list
 // left out of order sums its snaps in an order that may change from run to
 // run. The driver counts the trips of the 8 invocations side by side once, as
 // many as the longest takes, so a long list is cut where its own count
 // reaches the limit, and that is tested. `n`: the list's length, walked again.
 fn note_long_lists(n: u32) {
     if (list_trips + n + 1u >= LOOP_TRIPS) {
-        atomicStore(&status[21], 1u);
+        atomicStore(&status[STATUS_LISTS_CUT], 1u);
     }
 }
 

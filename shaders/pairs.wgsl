@@ -14,7 +14,7 @@
 // large body, the grid body; a fast body (`is_fast`) owns all it finds but
 // faster ones (`outranks`). Joined bodies are listed; the narrowphase drops them.
 
-// CONTACT_MARGIN (src/world.rs): the gap (m) kept as contact whatever the speed.
+// CONTACT_MARGIN (src/limits.rs): the gap (m) kept as contact whatever the speed.
 
 // Gap (m) within which pair (lo, hi) gets contacts: the fixed margin plus how
 // much nearer they may come in the coming step (relative displacement,
@@ -78,7 +78,7 @@ var<private> owned: u32;
 // The walk's loop trips so far, as the driver counts them (every trip, and the
 // one that ends each loop): lavapipe silently ends an invocation's loops at
 // LOOP_TRIPS, so a very long walk may have been cut; `note_long_walks` says
-// so in status[20].
+// so in status[STATUS_WALKS_CUT].
 var<private> trips: u32;
 
 // Partners each body's scratch room holds: body_pairs shared out by grid order
@@ -203,7 +203,7 @@ fn walk(i: u32) {
     let rings = select(1u, rings_of(size), walker.fast);
     let side = 2u * rings + 1u;
     let ahead = (side * side * side - 1u) / 2u;
-    let both = walker.fast || (walker.moves && atomicLoad(&status[11]) != 0u);
+    let both = walker.fast || (walker.moves && atomicLoad(&status[STATUS_GRID_SLEEPS]) != 0u);
     var cells = select(select(1u + ahead, 1u + 2u * ahead, both), 0u, sleeps || !grid);
     let cube = f32(side) * f32(side) * f32(side);
     let every = walker.fast && (cube >= f32(params.hash_size) || 2.0 * cube >= f32(cell_start[params.hash_size]));
@@ -255,14 +255,14 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
 // The loop trips of the workgroup's walks, summed (in any order).
 var<workgroup> group_trips: atomic<u32>;
 
-// Sets status[20] if a walk of the workgroup may have been cut short.
+// Sets status[STATUS_WALKS_CUT] if a walk of the workgroup may have been cut short.
 // Lavapipe counts a loop's trips once for the 8 invocations it runs side by
 // side, as many as the longest takes, so a vector's trips are at most the sum
 // of its invocations', and at most the workgroup's sum, tested here: the last
 // walk to add tests the whole sum, whatever the order.
 fn note_long_walks() {
     if (atomicAdd(&group_trips, trips) + trips >= LOOP_TRIPS) {
-        atomicStore(&status[20], 1u);
+        atomicStore(&status[STATUS_WALKS_CUT], 1u);
     }
 }
 

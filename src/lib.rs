@@ -18,6 +18,7 @@
 pub mod bench;
 pub mod gpu;
 mod json;
+pub mod limits;
 pub mod load_error;
 pub mod output;
 pub mod reference;

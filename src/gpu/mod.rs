@@ -2,6 +2,7 @@
 //! with WGSL, and shader assembly.
 
 pub mod shaders;
+pub mod status;
 pub mod types;
 
 use std::fmt;

@@ -15,8 +15,11 @@ pub const RESTITUTION: &str = include_str!("../../shaders/restitution.wgsl");
 /// values, as WGSL `const` declarations that go first in every module (the
 /// step's passes, the input kernels, the renderer).
 pub fn shared_constants() -> String {
+    use crate::gpu::status::{Status, DISPATCH_Y, DISPATCH_Z};
     use crate::gpu::types::*;
-    use crate::world::{FaultKind, CONTACT_MARGIN, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
+    use crate::limits::{
+        FaultKind, CONTACT_MARGIN, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT,
+    };
     let mut out = String::from("// Shared with Rust: written by src/gpu/shaders.rs from the Rust constants.\n");
     let words = [
         ("NONE", NONE),
@@ -44,8 +47,10 @@ pub fn shared_constants() -> String {
         ("FAULT_FAST", FaultKind::TooFast as u32),
         ("FAULT_SPIN", FaultKind::SpinsTooFast as u32),
         ("FAULT_ENERGY", FaultKind::FasterThanItsEnergy as u32),
+        ("DISPATCH_Y", DISPATCH_Y),
+        ("DISPATCH_Z", DISPATCH_Z),
     ];
-    for (name, value) in words {
+    for (name, value) in words.into_iter().chain(Status::WORDS) {
         out += &wgsl_u32(name, value);
     }
     for (name, value) in [

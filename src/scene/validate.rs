@@ -57,18 +57,18 @@ pub(super) fn validate_settings(s: &Settings) -> Result<(), SceneError> {
 }
 
 /// Why a step of `dt` s in `substeps` substeps is too short, if it is
-/// (`world::MIN_SUBSTEP`; a part in a million below it is let by, so 3e-5 s
+/// (`limits::MIN_SUBSTEP`; a part in a million below it is let by, so 3e-5 s
 /// in 3 substeps passes).
 pub fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
     let h = dt as f64 / substeps.max(1) as f64;
-    (h < crate::world::MIN_SUBSTEP as f64 * (1.0 - 1e-6)).then(|| {
+    (h < crate::limits::MIN_SUBSTEP as f64 * (1.0 - 1e-6)).then(|| {
         format!(
             "a step of {} s in {substeps} substeps makes substeps of {:.3e} s, shorter than {:e} s: over shorter substeps the \
          rounding of the poses reads as speed (a pyramid placed at rest read 0.35 m/s at 3.3e-7 s), and nothing comes \
          to rest; lengthen dt or take fewer substeps",
             show(dt),
             h,
-            crate::world::MIN_SUBSTEP
+            crate::limits::MIN_SUBSTEP
         )
     })
 }
@@ -94,7 +94,7 @@ pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError
     let Some(smallest) = bodies.iter().filter(|b| !b.fixed).map(|b| b.bounding_radius()).reduce(f32::min) else {
         return Ok(());
     };
-    use crate::world::MAX_DEPENETRATION_SPEED;
+    use crate::limits::MAX_DEPENETRATION_SPEED;
     let h = s.dt as f64 / s.substeps as f64;
     let g = (-s.gravity[1] as f64).max(0.0);
     let sweeps = s.sweeps(s.substeps.max(1) - 1);
@@ -136,9 +136,9 @@ fn length(v: [f32; 3]) -> f64 {
 }
 
 /// Why a body placed at `p` (m) is absurd, if it is: farther than
-/// `world::MAX_DISTANCE` from the origin, where the step stops it as a fault.
+/// `limits::MAX_DISTANCE` from the origin, where the step stops it as a fault.
 pub fn position_problem(p: [f32; 3]) -> Option<String> {
-    use crate::world::MAX_DISTANCE;
+    use crate::limits::MAX_DISTANCE;
     let distance = length(p);
     (distance > MAX_DISTANCE as f64).then(|| {
         format!("lies {distance:.4e} m from the origin; at most {MAX_DISTANCE:e} m is sane (the step stops a body beyond it)")
@@ -146,20 +146,20 @@ pub fn position_problem(p: [f32; 3]) -> Option<String> {
 }
 
 /// Why a body moving at `v` (m/s) is absurd, if it is: faster than
-/// `world::MAX_SPEED`, where the step stops it as a fault.
+/// `limits::MAX_SPEED`, where the step stops it as a fault.
 pub fn speed_problem(v: [f32; 3]) -> Option<String> {
-    use crate::world::MAX_SPEED;
+    use crate::limits::MAX_SPEED;
     let speed = length(v);
     (speed > MAX_SPEED as f64)
         .then(|| format!("moves at {speed:.4e} m/s; at most {MAX_SPEED:e} m/s is sane (the step stops a faster body)"))
 }
 
 /// Why an angular velocity `w` (rad/s) is absurd for substeps of `h` s (0:
-/// any), if it is: faster than `world::MAX_SPIN`, or turning more than
-/// `world::MAX_TURN` in one substep, which a pose pair cannot hold (the
+/// any), if it is: faster than `limits::MAX_SPIN`, or turning more than
+/// `limits::MAX_TURN` in one substep, which a pose pair cannot hold (the
 /// numerical-fault check of integrate.wgsl would stop the body).
 pub fn spin_problem(w: [f32; 3], h: f32) -> Option<String> {
-    use crate::world::{MAX_SPIN, MAX_TURN};
+    use crate::limits::{MAX_SPIN, MAX_TURN};
     let rate = w.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
     if rate > MAX_SPIN as f64 {
         return Some(format!("spins at {rate:.4e} rad/s; at most {MAX_SPIN:e} rad/s is sane"));
@@ -269,7 +269,7 @@ pub(super) fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Re
         check_all_finite(anchor, &at)?;
         // a world point, or an offset from the body's centre: beyond what a
         // body may reach (it would be stopped as a fault there)
-        use crate::world::MAX_DISTANCE;
+        use crate::limits::MAX_DISTANCE;
         let distance = length(*anchor);
         if distance > MAX_DISTANCE as f64 {
             let from = if joint.bodies[k] == WORLD { "the origin" } else { "its body's centre" };

@@ -421,7 +421,7 @@ pub fn speed_limits(scene: &Scene) -> Vec<f32> {
         _ if g == DVec3::ZERO => None,
         _ => return vec![0.0; scene.bodies.len()],
     };
-    let push = crate::world::MAX_DEPENETRATION_SPEED as f64;
+    let push = crate::limits::MAX_DEPENETRATION_SPEED as f64;
     let mut energy = 0.0;
     for b in scene.bodies.iter().filter(|b| !b.fixed) {
         let m = b.mass as f64;

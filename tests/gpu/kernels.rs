@@ -446,7 +446,7 @@ fn ball_over_a_floor(side: usize) -> Option<(verlet::World, verlet::world::Conta
 
 /// A fast body's walk over a whole grid takes every pair it wants, and a
 /// walk long enough that the driver may cut it short is reported
-/// (`ContactReport::walks_cut`, status[20]). Over 20 164 cubes the ball
+/// (`ContactReport::walks_cut`, `Status::walks_cut`). Over 20 164 cubes the ball
 /// walked every one of the grid's 65 536 buckets, past lavapipe's 65535
 /// loop trips, and 1489 of its 2145 pairs were lost (reported); it now
 /// walks the grid's 20 164 places, finds them all, and its workgroup's
@@ -613,7 +613,7 @@ fn long_lists_in_random_order_come_out_in_pair_order() {
 }
 
 /// A list too long for the driver to sort within its loop limit is
-/// reported (`ContactReport::lists_cut`, status[21]): a box resting on 5000
+/// reported (`ContactReport::lists_cut`, `Status::lists_cut`): a box resting on 5000
 /// fixed boxes placed at one spot lists 5000 manifolds, and its sums ran in
 /// an order that changed from run to run (it diverged at step 33 or 46 by
 /// the run). 2000 are sorted whole and not reported. Where the driver has

@@ -153,7 +153,7 @@ fn constants_match() {
         naga::Expression::Literal(naga::Literal::F32(v)) => v,
         e => panic!("{name}: unexpected {e:?}"),
     };
-    use verlet::world::{FaultKind, CONTACT_MARGIN, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
+    use verlet::limits::{FaultKind, CONTACT_MARGIN, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT};
     for (name, value) in [
         ("SHAPE_BOX", SHAPE_BOX),
         ("SHAPE_SPHERE", SHAPE_SPHERE),
@@ -198,6 +198,57 @@ fn constants_match() {
     assert!(
         matches!(module.global_expressions[c.init], naga::Expression::Literal(naga::Literal::F32(v)) if v == 0.1 + f32::EPSILON)
     );
+}
+
+/// The status record's word constants (`STATUS_*`), as every module sees
+/// them, are its fields' places in the Rust struct, member by member, and
+/// the fields named here tile the struct (none left out, none overlapping).
+#[test]
+fn status_words_match_the_struct() {
+    use verlet::gpu::status::{Status, DISPATCH_Y, DISPATCH_Z};
+    let module = shaders::validate(&verlet::step::Stage::Integrate.source()).unwrap();
+    let word = |name: &str| {
+        let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v as usize,
+            ref e => panic!("{name}: unexpected {e:?}"),
+        }
+    };
+    macro_rules! check_words {
+        ($($field:ident => $name:literal),* $(,)?) => {{
+            let status = Status::INIT;
+            let mut end = 0;
+            $(
+                assert_eq!(offset_of!(Status, $field), end, "Status.{}: not right after the field before", stringify!($field));
+                assert_eq!(4 * word($name), offset_of!(Status, $field), "{} differs from Status.{}", $name, stringify!($field));
+                end += std::mem::size_of_val(&status.$field);
+            )*
+            assert_eq!(end, size_of::<Status>(), "Status: fields left out here");
+            assert_eq!(Status::WORDS.len(), [$($name),*].len(), "Status::WORDS: names not checked here");
+        }};
+    }
+    check_words!(
+        pairs => "STATUS_PAIRS",
+        pairs_max => "STATUS_PAIRS_MAX",
+        fault => "STATUS_FAULT",
+        fault_step => "STATUS_FAULT_STEP",
+        manifolds => "STATUS_MANIFOLDS",
+        manifolds_max => "STATUS_MANIFOLDS_MAX",
+        manifolds_top => "STATUS_MANIFOLDS_TOP",
+        manifolds_bottom => "STATUS_MANIFOLDS_BOTTOM",
+        pairs_dispatch => "STATUS_PAIRS_DISPATCH",
+        grid_sleeps => "STATUS_GRID_SLEEPS",
+        manifolds_dispatch => "STATUS_MANIFOLDS_DISPATCH",
+        moving => "STATUS_MOVING",
+        listed => "STATUS_LISTED",
+        listed_dispatch => "STATUS_LISTED_DISPATCH",
+        walks_cut => "STATUS_WALKS_CUT",
+        lists_cut => "STATUS_LISTS_CUT",
+    );
+    assert_eq!(Status::BYTES as usize, size_of::<Status>());
+    // a dispatch's three words as wgpu reads them: x, y, z
+    assert_eq!((word("DISPATCH_Y"), word("DISPATCH_Z")), (DISPATCH_Y as usize, DISPATCH_Z as usize));
+    assert_eq!((DISPATCH_Y, DISPATCH_Z), (1, 2));
 }
 
 /// common.wgsl holds types and maths only: with the shared constants it is a

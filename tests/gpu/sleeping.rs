@@ -380,7 +380,7 @@ fn the_body_passes_run_over_the_awake_bodies_and_leave_sleepers_alike_in_both_bu
     let Some(mut w) = world(&scene) else { return };
     let steps = step_until_asleep(&mut w, n / 2, 1200);
     let listed = |w: &verlet::World| {
-        let count = w.read_words(Buffer::Status).unwrap()[16] as usize;
+        let count = w.read_status().unwrap().listed as usize;
         w.read_words(Buffer::Sorted).unwrap()[n..n + count].to_vec()
     };
     let list = listed(&w);

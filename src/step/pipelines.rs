@@ -1,0 +1,92 @@
+//! The step's compiled pipelines and their bind group layouts.
+
+use super::{Buffer, Stage};
+use crate::gpu::{types::Params, Gpu};
+
+/// The most storage buffers any stage binds; the device must allow this
+/// many per shader stage.
+pub fn storage_buffers() -> u32 {
+    Stage::ALL.iter().map(|s| s.buffers().iter().filter(|b| **b != Buffer::Params).count() as u32).max().unwrap_or(0)
+}
+
+/// The step's compiled pipelines, each with its own bind group layout (the
+/// buffers its entry point uses: every pass of the step binds fewer than
+/// the 16 storage buffers an adapter is asked for, though the step has
+/// more).
+pub struct StepPipelines {
+    layouts: Vec<wgpu::BindGroupLayout>,
+    pipelines: Vec<wgpu::ComputePipeline>,
+    /// Compiled for a manifold pool in parts (POOL_SPLIT in bindings.wgsl).
+    pub pool_split: bool,
+}
+
+fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
+    let ty = match buffer {
+        // one Params slot per substep, chosen by the dynamic offset
+        Buffer::Params => wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+        },
+        // read-only where no stage writes (props, state_in, the joints)
+        _ => wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: buffer.read_only() },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    };
+    wgpu::BindGroupLayoutEntry { binding: buffer.binding(), visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+}
+
+/// Compiles one pass with its layout (the override constants: POOL_SPLIT,
+/// DISPATCH_ROW from the device's limits, the stage's own from its row,
+/// LOOP_TRIPS where the driver limits loops).
+fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: bool) -> wgpu::ComputePipeline {
+    let mut constants = vec![
+        ("POOL_SPLIT", f64::from(u8::from(pool_split))),
+        ("DISPATCH_ROW", f64::from(gpu.limits.max_compute_workgroups_per_dimension)),
+    ];
+    constants.extend_from_slice(stage.info().constants);
+    if let Some(trips) = gpu.loop_trips() {
+        constants.push(("LOOP_TRIPS", f64::from(trips)));
+    }
+    let mut one = gpu.compute_pipelines(stage.name(), &stage.source(), &[stage.entry_point()], Some(&[layout]), &constants);
+    one.remove(0)
+}
+
+impl StepPipelines {
+    /// Compiles the step's passes, for a manifold pool in parts where
+    /// `pool_split` (see `World::make_pools`).
+    pub fn new(gpu: &Gpu, pool_split: bool) -> StepPipelines {
+        let device = &gpu.device;
+        let layouts: Vec<wgpu::BindGroupLayout> = Stage::ALL
+            .iter()
+            .map(|stage| {
+                let entries: Vec<wgpu::BindGroupLayoutEntry> = stage.buffers().into_iter().map(entry).collect();
+                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(stage.name()), entries: &entries })
+            })
+            .collect();
+        let pipelines = Stage::ALL.iter().map(|&stage| compile(gpu, stage, &layouts[stage as usize], pool_split)).collect();
+        StepPipelines { layouts, pipelines, pool_split }
+    }
+
+    /// Compiles the passes that touch the manifold pool's parts again, for
+    /// a pool in parts (POOL_SPLIT on; see `World::make_pools`).
+    pub fn split_pool(&mut self, gpu: &Gpu) {
+        for stage in Stage::ALL {
+            let buffers = stage.buffers();
+            if buffers.contains(&Buffer::Points) || buffers.contains(&Buffer::Snaps1) {
+                self.pipelines[stage as usize] = compile(gpu, stage, &self.layouts[stage as usize], true);
+            }
+        }
+        self.pool_split = true;
+    }
+
+    pub fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {
+        &self.pipelines[stage as usize]
+    }
+
+    pub fn layout(&self, stage: Stage) -> &wgpu::BindGroupLayout {
+        &self.layouts[stage as usize]
+    }
+}

@@ -1,0 +1,389 @@
+//! The stages of a step, one row of `TABLE` each: everything the host knows
+//! of a stage is in its row, and every other list (the stages in order,
+//! the bind group layouts, the dispatches, the profile's parts) is derived
+//! from the table.
+
+use super::Buffer;
+use crate::gpu::shaders;
+
+/// The stages of a step, in order; each indexes its row of `TABLE`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    GridCount,
+    GridScanBlocks,
+    GridScanSums,
+    GridScanAdd,
+    GridScatter,
+    GridSort,
+    PairsCount,
+    PairsScanBlocks,
+    PairsScanSums,
+    PairsWrite,
+    Narrowphase,
+    NarrowphaseGround,
+    ContactLists,
+    NarrowphaseClip,
+    Integrate,
+    SolveContacts,
+    Solve,
+    JointRest,
+    SolveJoints,
+    RestitutionContacts,
+    Restitution,
+}
+
+/// What one invocation of a stage works on, which sizes its dispatch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Over {
+    Bodies,
+    Buckets,
+    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` buckets.
+    ScanBlocks,
+    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` bodies.
+    BodyScanBlocks,
+    /// A single workgroup.
+    One,
+    /// The candidate pairs: an indirect dispatch whose size the pair scan
+    /// wrote (`Status::pairs_dispatch`).
+    Pairs,
+    /// The manifolds in the pool: an indirect dispatch whose size
+    /// `contact_lists` wrote (`Status::manifolds_dispatch`).
+    Manifolds,
+    /// The joint islands (see `joint_lists`).
+    Islands,
+    /// The joint paths of one colour (see `joint_lists`): the widest
+    /// colour's count, each dispatch bounded by its Params.
+    Paths,
+    /// The bodies the step may change (`listed_body` in bindings.wgsl): an
+    /// indirect dispatch whose size `contact_lists` counted
+    /// (`Status::listed_dispatch`).
+    Listed,
+}
+
+/// What a stage does with the pose buffers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Poses {
+    /// Reads the current state only.
+    Read,
+    /// Reads the current state and writes the other (state_out), which then
+    /// becomes current.
+    Flip,
+    /// Edits the current state in place: it is bound through the bind group
+    /// whose state_out is the current state (the one the pass before it
+    /// wrote), and nothing flips.
+    InPlace,
+}
+
+/// When a stage runs within a step (`World::step_plan`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Runs {
+    /// Once a step, before the substeps, in the table's order.
+    EachStep,
+    /// Once a step, where the grid's scan spans more than one block of
+    /// `SCAN_SPAN` buckets: the scan's first pass finishes a scan of one.
+    EachStepOverManyBuckets,
+    /// Once a step, where the pairs' scan spans more than one block of
+    /// `SCAN_SPAN` bodies.
+    EachStepOverManyBodies,
+    /// In every substep, where `World::step_plan` places it.
+    InSubsteps,
+}
+
+/// The parts of a step, as the bench and the profile sum them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    Broadphase,
+    Narrowphase,
+    Integrate,
+    Solve,
+    Restitution,
+}
+
+/// One row of the table: a stage as the host sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct StageInfo {
+    pub stage: Stage,
+    /// The label of its compute pass and its bind group.
+    pub name: &'static str,
+    /// Its WGSL entry point: named like the stage, but for the scan passes,
+    /// which grid.wgsl holds once for the grid and the pairs.
+    pub entry_point: &'static str,
+    /// The WGSL files its module is made of, in order (src/gpu/shaders.rs).
+    pub pieces: &'static [&'static str],
+    /// Override constants of its own (besides the ones every stage gets).
+    pub constants: &'static [(&'static str, f64)],
+    pub over: Over,
+    pub poses: Poses,
+    pub runs: Runs,
+    /// The buffers the entry point reads and writes: every buffer its code
+    /// can touch, as naga's analysis finds it (tests/gpu/shaders.rs checks
+    /// both lists), so a branch not taken counts. An atomic is a read and a
+    /// write; `arrayLength` is a read (the buffer must be bound).
+    pub reads: &'static [Buffer],
+    pub writes: &'static [Buffer],
+    /// The indirect dispatch sizes copied out of the status record before
+    /// the stage runs, and after: a copy cannot sit inside a compute pass,
+    /// so the step's passes are split there (`World::encode_step`).
+    pub copy_before: &'static [Over],
+    pub copy_after: &'static [Over],
+    pub part: Part,
+}
+
+impl StageInfo {
+    /// A row with the commonest values, for the table to override.
+    const fn row(stage: Stage, name: &'static str, pieces: &'static [&'static str], part: Part) -> StageInfo {
+        StageInfo {
+            stage,
+            name,
+            entry_point: name,
+            pieces,
+            constants: &[],
+            over: Over::Bodies,
+            poses: Poses::Read,
+            runs: Runs::EachStep,
+            reads: &[],
+            writes: &[],
+            copy_before: &[],
+            copy_after: &[],
+            part,
+        }
+    }
+}
+
+/// Every stage, in the order of `Stage` (checked as the table is built).
+pub const TABLE: [StageInfo; 21] = {
+    use shaders::{GRID_PASS, INTEGRATE_PASS, NARROWPHASE_PASS, PAIRS_PASS, RESTITUTION_PASS, SOLVE_PASS};
+    use Buffer::*;
+    use Part::{Broadphase, Narrowphase};
+    use StageInfo as S;
+    // grid.wgsl's scans, for the grid's buckets or (SCAN_PAIRS) the bodies' pair counts
+    const SCAN_BLOCKS_READS: &[Buffer] = &[Params, CellCount, CellStart, Pairs, Status, PairMeta];
+    const SCAN_SUMS_READS: &[Buffer] = &[Params, BlockSums, Pairs, Status];
+    const SCAN_WRITES: &[Buffer] = &[CellStart, BlockSums, Status, PairMeta];
+    const SCAN_PAIRS: &[(&str, f64)] = &[("SCAN_PAIRS", 1.0)];
+    const POOL_WRITES: &[Buffer] = &[Manifolds, Status, PairMeta, BodyPairs, Points, Points1, Points2, Points3];
+    const SNAP_WRITES: &[Buffer] = &[Snaps, Points, Points1, Points2, Points3, Snaps1];
+    const JOINT_READS: &[Buffer] = &[Params, Props, StateOut, JointStart, JointRefs];
+    let table = [
+        S {
+            reads: &[Params, Props, StateIn, CellCount, Status],
+            writes: &[CellCount, Status, PairMeta],
+            ..S::row(Stage::GridCount, "grid_count", GRID_PASS, Broadphase)
+        },
+        S {
+            entry_point: "scan_blocks",
+            over: Over::ScanBlocks,
+            reads: SCAN_BLOCKS_READS,
+            writes: SCAN_WRITES,
+            ..S::row(Stage::GridScanBlocks, "grid_scan_blocks", GRID_PASS, Broadphase)
+        },
+        S {
+            entry_point: "scan_sums",
+            over: Over::One,
+            runs: Runs::EachStepOverManyBuckets,
+            reads: SCAN_SUMS_READS,
+            writes: SCAN_WRITES,
+            ..S::row(Stage::GridScanSums, "grid_scan_sums", GRID_PASS, Broadphase)
+        },
+        S {
+            entry_point: "scan_add",
+            over: Over::Buckets,
+            runs: Runs::EachStepOverManyBuckets,
+            reads: &[Params, CellStart, BlockSums],
+            writes: &[CellStart],
+            ..S::row(Stage::GridScanAdd, "grid_scan_add", GRID_PASS, Broadphase)
+        },
+        S {
+            reads: &[Params, Props, StateIn, CellCount, CellStart],
+            writes: &[CellCount, Sorted],
+            ..S::row(Stage::GridScatter, "grid_scatter", GRID_PASS, Broadphase)
+        },
+        S {
+            reads: &[Params, Props, StateIn, CellStart, Sorted, PairMeta],
+            writes: &[Sorted, CellBounds],
+            ..S::row(Stage::GridSort, "grid_sort", GRID_PASS, Broadphase)
+        },
+        S {
+            reads: &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds],
+            writes: &[Sorted, Pairs, Status, PairMeta, BodyPairs],
+            ..S::row(Stage::PairsCount, "pairs_count", PAIRS_PASS, Narrowphase)
+        },
+        S {
+            entry_point: "scan_blocks",
+            constants: SCAN_PAIRS,
+            over: Over::BodyScanBlocks,
+            reads: SCAN_BLOCKS_READS,
+            writes: SCAN_WRITES,
+            ..S::row(Stage::PairsScanBlocks, "pairs_scan_blocks", GRID_PASS, Narrowphase)
+        },
+        S {
+            entry_point: "scan_sums",
+            constants: SCAN_PAIRS,
+            over: Over::One,
+            runs: Runs::EachStepOverManyBodies,
+            reads: SCAN_SUMS_READS,
+            writes: SCAN_WRITES,
+            ..S::row(Stage::PairsScanSums, "pairs_scan_sums", GRID_PASS, Narrowphase)
+        },
+        S {
+            reads: &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds],
+            writes: &[Pairs, PairMeta, BodyPairs],
+            ..S::row(Stage::PairsWrite, "pairs_write", PAIRS_PASS, Narrowphase)
+        },
+        S {
+            over: Over::Pairs,
+            reads: &[Params, Props, StateIn, Pairs, Manifolds, Status, JointStart, JointRefs, PairMeta, BodyPairs, Points],
+            writes: POOL_WRITES,
+            // the pair scan's last pass wrote it: the grid's or the pairs' sums where they run
+            copy_before: &[Over::Pairs],
+            ..S::row(Stage::Narrowphase, "narrowphase", NARROWPHASE_PASS, Narrowphase)
+        },
+        S {
+            reads: &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs, Points],
+            writes: POOL_WRITES,
+            ..S::row(Stage::NarrowphaseGround, "narrowphase_ground", NARROWPHASE_PASS, Narrowphase)
+        },
+        S {
+            reads: &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
+            writes: &[Sorted, Status, PairMeta, BodyPairs],
+            // once, for every contact and body pass of the step's substeps
+            copy_after: &[Over::Manifolds, Over::Listed],
+            ..S::row(Stage::ContactLists, "contact_lists", NARROWPHASE_PASS, Narrowphase)
+        },
+        S {
+            over: Over::Manifolds,
+            reads: &[Params, Props, StateIn, Manifolds, Status, PairMeta, Points],
+            writes: &[Manifolds, PairMeta, Points, Points1, Points2, Points3],
+            ..S::row(Stage::NarrowphaseClip, "narrowphase_clip", NARROWPHASE_PASS, Narrowphase)
+        },
+        S {
+            over: Over::Listed,
+            poses: Poses::Flip,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta, Snaps, BodyPairs, Snaps1],
+            writes: &[StateOut, Vel0, Status, PairMeta],
+            ..S::row(Stage::Integrate, "integrate", INTEGRATE_PASS, Part::Integrate)
+        },
+        S {
+            over: Over::Manifolds,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            writes: SNAP_WRITES,
+            ..S::row(Stage::SolveContacts, "solve_contacts", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::Listed,
+            poses: Poses::Flip,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1],
+            writes: &[StateOut],
+            ..S::row(Stage::Solve, "solve", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::Islands,
+            poses: Poses::InPlace,
+            runs: Runs::InSubsteps,
+            reads: JOINT_READS,
+            writes: &[StateOut],
+            ..S::row(Stage::JointRest, "joint_rest", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::Paths,
+            poses: Poses::InPlace,
+            runs: Runs::InSubsteps,
+            reads: JOINT_READS,
+            writes: &[StateOut],
+            ..S::row(Stage::SolveJoints, "solve_joints", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::Manifolds,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            writes: SNAP_WRITES,
+            ..S::row(Stage::RestitutionContacts, "restitution_contacts", RESTITUTION_PASS, Part::Restitution)
+        },
+        S {
+            over: Over::Listed,
+            poses: Poses::Flip,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, Snaps1],
+            writes: &[StateOut],
+            ..S::row(Stage::Restitution, "restitution", RESTITUTION_PASS, Part::Restitution)
+        },
+    ];
+    // each row sits at its stage's index
+    let mut k = 0;
+    while k < table.len() {
+        assert!(table[k].stage as usize == k, "TABLE is out of the order of Stage");
+        k += 1;
+    }
+    table
+};
+
+impl Stage {
+    /// Every stage, in order.
+    pub const ALL: [Stage; TABLE.len()] = {
+        let mut all = [Stage::GridCount; TABLE.len()];
+        let mut k = 0;
+        while k < all.len() {
+            all[k] = TABLE[k].stage;
+            k += 1;
+        }
+        all
+    };
+
+    /// Its row of the table.
+    pub fn info(self) -> &'static StageInfo {
+        &TABLE[self as usize]
+    }
+
+    /// The label of its compute pass; its entry point but for the scans.
+    pub fn name(self) -> &'static str {
+        self.info().name
+    }
+
+    pub fn entry_point(self) -> &'static str {
+        self.info().entry_point
+    }
+
+    pub fn pieces(self) -> &'static [&'static str] {
+        self.info().pieces
+    }
+
+    /// Its module's source: the shared constants, then its pieces.
+    pub fn source(self) -> String {
+        shaders::shared_constants() + &self.pieces().concat()
+    }
+
+    pub fn reads(self) -> &'static [Buffer] {
+        self.info().reads
+    }
+
+    pub fn writes(self) -> &'static [Buffer] {
+        self.info().writes
+    }
+
+    /// The buffers it binds (what it reads or writes), by binding: its bind
+    /// group layout holds these alone.
+    pub fn buffers(self) -> Vec<Buffer> {
+        Buffer::ALL.iter().copied().filter(|b| self.reads().contains(b) || self.writes().contains(b)).collect()
+    }
+
+    pub fn over(self) -> Over {
+        self.info().over
+    }
+
+    pub fn poses(self) -> Poses {
+        self.info().poses
+    }
+
+    /// The part of the step it belongs to, as the bench and the profile sum them.
+    pub fn part(self) -> Part {
+        self.info().part
+    }
+
+    /// Whether the stage is part of the grid broadphase (`grid_*`).
+    pub fn is_broadphase(self) -> bool {
+        self.part() == Part::Broadphase
+    }
+}

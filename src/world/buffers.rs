@@ -1,0 +1,263 @@
+//! The GPU buffers of a world and the step's bind groups over them.
+
+use std::mem::{offset_of, size_of};
+
+use bytemuck::{Pod, Zeroable};
+
+use super::capacity::{pair_capacities, pool_parts};
+use super::encode::MAX_BATCH;
+use super::records::{GridLayout, JointLists};
+use crate::gpu::status::Status;
+use crate::gpu::{types::*, Gpu};
+use crate::step::{Buffer, Over, Stage, StepPipelines};
+
+/// The GPU buffers of a world, made at start-up; only the pair list and the
+/// manifold pool are made again (`World::make_pools`), as the contacts a
+/// step wants grow or shrink.
+pub(super) struct WorldData {
+    pub states: [wgpu::Buffer; 2],
+    pub params: wgpu::Buffer,
+    pub status: wgpu::Buffer,
+    /// The pair pipeline (shaders/pairs.wgsl): candidate pairs, the
+    /// manifold pool, each body's pair bookkeeping and its pair list.
+    pub pairs: wgpu::Buffer,
+    /// The manifolds' headers, and their points in up to four parts (see
+    /// `pool_parts`).
+    pub manifolds: wgpu::Buffer,
+    pub points: [wgpu::Buffer; 4],
+    /// What each manifold asks of its two bodies in a sweep (two per
+    /// manifold slot; solve.wgsl, restitution.wgsl), in up to two parts.
+    pub snaps: [wgpu::Buffer; 2],
+    pub pair_meta: wgpu::Buffer,
+    pub body_pairs: wgpu::Buffer,
+    /// The indirect dispatches' sizes (`Dispatches`), copied out of
+    /// `status`: a buffer a pass binds as storage cannot also give it its
+    /// indirect sizes.
+    pub dispatch: wgpu::Buffer,
+    /// Each stage's two bind groups, by stage (`step_bind_groups`; always
+    /// made, right after the buffers).
+    pub bind_groups: Option<Vec<[wgpu::BindGroup; 2]>>,
+    /// Shapes, masses and materials (written by the input kernel too).
+    pub props: wgpu::Buffer,
+    /// What the scene fixed at start-up: the bodies kept out of the grid
+    /// (copied into the tail of `sorted`, where the passes read them) and the
+    /// joint lists (the snapshot's scene hash reads them all).
+    pub statics: [wgpu::Buffer; 3],
+    /// Working buffers of the passes: vel0, and the grid's cell_count,
+    /// cell_start, block_sums, sorted and cell_bounds.
+    pub scratch: [wgpu::Buffer; 6],
+    /// What a batch of steps starts from (the state and `status`; nothing
+    /// else carries over from one step to the next, see snapshot.rs),
+    /// copied as each batch begins, so that a batch during which a pool
+    /// overflowed is taken again from the same start once the pools have
+    /// grown (`World::step_with`).
+    pub batch_start: [wgpu::Buffer; 2],
+}
+
+/// The `dispatch` buffer: each indirect dispatch's size (x, y, z) in a
+/// 16-byte slot of its own.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(super) struct Dispatches {
+    pairs: [u32; 3],
+    _pad0: u32,
+    manifolds: [u32; 3],
+    _pad1: u32,
+    listed: [u32; 3],
+    _pad2: u32,
+}
+
+/// Where an indirect dispatch over `over` takes its size: its place in the
+/// `dispatch` buffer and the status words its kernel wrote it into (bytes);
+/// `None` for a dispatch the host sizes.
+pub(super) fn indirect(over: Over) -> Option<(u64, u64)> {
+    let (slot, words) = match over {
+        Over::Pairs => (offset_of!(Dispatches, pairs), offset_of!(Status, pairs_dispatch)),
+        Over::Manifolds => (offset_of!(Dispatches, manifolds), offset_of!(Status, manifolds_dispatch)),
+        Over::Listed => (offset_of!(Dispatches, listed), offset_of!(Status, listed_dispatch)),
+        _ => return None,
+    };
+    Some((slot as u64, words as u64))
+}
+
+/// Bytes of one indirect dispatch's size.
+pub(super) const DISPATCH_BYTES: u64 = size_of::<[u32; 3]>() as u64;
+
+impl WorldData {
+    /// Makes and fills the buffers of a scene of `n` bodies (`props`,
+    /// `states`, the bodies kept out of the grid `large`, `joints`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        gpu: &Gpu,
+        n: usize,
+        props: &[BodyProps],
+        states: &[BodyState],
+        large: &[u32],
+        grid: &GridLayout,
+        joints: &JointLists,
+        substeps: u32,
+    ) -> WorldData {
+        let device = &gpu.device;
+        let count = n.max(1); // wgpu buffers may not be empty
+        let storage = |label: &str, size: u64| storage_buffer(device, label, size);
+        let with_data = |label: &str, bytes: &[u8]| {
+            let buf = storage(label, bytes.len() as u64);
+            if !bytes.is_empty() {
+                gpu.queue.write_buffer(&buf, 0, bytes);
+            }
+            buf
+        };
+        let hash = grid.hash_size as u64;
+        let props_buf = with_data("props", bytemuck::cast_slice(props));
+        let state_bufs = [with_data("state A", bytemuck::cast_slice(states)), with_data("state B", bytemuck::cast_slice(states))];
+        let vel0 = storage("vel0", (count * size_of::<Velocity>()) as u64);
+        let cell_count = storage("grid/cell_count", 4 * hash);
+        let cell_start = storage("grid/cell_start", 4 * (hash + 1));
+        // block totals of the grid's scan and the pairs' (xy)
+        let block_sums = storage("scan/block_sums", 8 * hash.max(count as u64).div_ceil(SCAN_SPAN as u64));
+        // the grid's order, then the step's listed bodies (`listed_body` in bindings.wgsl)
+        let sorted = storage("grid/sorted", 8 * count as u64);
+        // the grid bodies' bounds in the grid's order (grid_sort, for the pair walks)
+        let cell_bounds = storage("grid/cell_bounds", (count * size_of::<CellBound>()) as u64);
+        let large_buf = with_data("grid/large", bytemuck::cast_slice(large));
+        let (pair_capacity, manifold_capacity) = pair_capacities(gpu, count as u64);
+        let pairs = storage("pairs", pair_capacity * size_of::<Pair>() as u64);
+        let (heads, point_parts, snap_parts) = pool_parts(gpu, manifold_capacity);
+        let manifolds = storage("manifolds", heads);
+        let points = point_parts.map(|size| storage("manifolds/points", size));
+        let snaps = snap_parts.map(|size| storage("manifolds/snaps", size));
+        let meta_bytes = (count as u64 + 1) * size_of::<PairMeta>() as u64;
+        let pair_meta = storage("pairs/meta", meta_bytes);
+        let state_bytes = (count * size_of::<BodyState>()) as u64;
+        let body_pairs = storage("pairs/body_lists", 2 * pair_capacity * 4);
+        let status = with_data("status", bytemuck::bytes_of(&Status::INIT));
+        let dispatch = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("indirect dispatches"),
+            size: size_of::<Dispatches>() as u64,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let joint_start = with_data("joints/start", bytemuck::cast_slice(&joints.starts));
+        let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&joints.refs));
+        // a batch's substeps' slots, each substep's own and one per colour of joint paths
+        let slots = MAX_BATCH.max(substeps as usize * (1 + joints.colour_count() as usize));
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: PARAMS_STRIDE * slots as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        WorldData {
+            states: state_bufs,
+            params,
+            status,
+            pairs,
+            manifolds,
+            points,
+            snaps,
+            pair_meta,
+            body_pairs,
+            dispatch,
+            bind_groups: None,
+            props: props_buf,
+            statics: [large_buf, joint_start, joint_refs],
+            scratch: [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds],
+            batch_start: [storage("batch start/state", state_bytes), storage("batch start/status", Status::BYTES)],
+        }
+    }
+
+    /// `sorted`: the grid's order, then the bodies the step's body passes
+    /// run over.
+    pub fn sorted(&self) -> &wgpu::Buffer {
+        &self.scratch[4]
+    }
+
+    /// The buffer bound at `buffer`'s binding while `states[from]` is the
+    /// current state (state_in) and the other the next (state_out).
+    pub fn buffer(&self, buffer: Buffer, from: usize) -> &wgpu::Buffer {
+        let [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds] = &self.scratch;
+        let [_, joint_start, joint_refs] = &self.statics;
+        match buffer {
+            Buffer::Params => &self.params,
+            Buffer::Props => &self.props,
+            Buffer::StateIn => &self.states[from],
+            Buffer::StateOut => &self.states[1 - from],
+            Buffer::Vel0 => vel0,
+            Buffer::CellCount => cell_count,
+            Buffer::CellStart => cell_start,
+            Buffer::BlockSums => block_sums,
+            Buffer::Sorted => sorted,
+            Buffer::Snaps => &self.snaps[0],
+            Buffer::Snaps1 => &self.snaps[1],
+            Buffer::Points => &self.points[0],
+            Buffer::Points1 => &self.points[1],
+            Buffer::Points2 => &self.points[2],
+            Buffer::Points3 => &self.points[3],
+            Buffer::Pairs => &self.pairs,
+            Buffer::Manifolds => &self.manifolds,
+            Buffer::Status => &self.status,
+            Buffer::JointStart => joint_start,
+            Buffer::JointRefs => joint_refs,
+            Buffer::PairMeta => &self.pair_meta,
+            Buffer::BodyPairs => &self.body_pairs,
+            Buffer::CellBounds => cell_bounds,
+        }
+    }
+
+    /// Every stage's two bind groups (its buffers, `Stage::buffers`), by
+    /// stage: `[k]` reads `states[k]` and writes `states[1 - k]`.
+    pub fn step_bind_groups(&self, device: &wgpu::Device, pipelines: &StepPipelines) -> Vec<[wgpu::BindGroup; 2]> {
+        let group = |stage: Stage, from: usize| {
+            let entries: Vec<wgpu::BindGroupEntry> = stage
+                .buffers()
+                .into_iter()
+                .map(|buffer| {
+                    let b = self.buffer(buffer, from);
+                    // Params: one substep's slot, chosen by the dynamic offset
+                    let size = (buffer == Buffer::Params).then_some(size_of::<Params>() as u64);
+                    let resource = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: b,
+                        offset: 0,
+                        size: size.and_then(wgpu::BufferSize::new),
+                    });
+                    wgpu::BindGroupEntry { binding: buffer.binding(), resource }
+                })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(stage.name()),
+                layout: pipelines.layout(stage),
+                entries: &entries,
+            })
+        };
+        Stage::ALL.iter().map(|&stage| [group(stage, 0), group(stage, 1)]).collect()
+    }
+
+    /// Bytes of GPU memory the buffers hold now.
+    pub fn bytes(&self) -> u64 {
+        let buffers = [
+            &self.params,
+            &self.status,
+            &self.pairs,
+            &self.manifolds,
+            &self.pair_meta,
+            &self.body_pairs,
+            &self.dispatch,
+            &self.props,
+        ];
+        buffers.iter().map(|b| b.size()).sum::<u64>()
+            + self.states.iter().chain(&self.statics).chain(&self.scratch).chain(&self.batch_start).map(|b| b.size()).sum::<u64>()
+            + self.points.iter().chain(&self.snaps).map(|b| b.size()).sum::<u64>()
+    }
+}
+
+/// A storage buffer of the step (copied to and from), of at least one
+/// element of the largest struct a binding holds: an empty list still binds
+/// a buffer as large as the shader's element.
+pub(super) fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(64),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}

@@ -1,0 +1,304 @@
+//! `World`: a scene's bodies living on the GPU, stepped by the passes of
+//! `step` in batches, read back only on request.
+//!
+//! The type and its stepping API are here; the rest of the world is split
+//! by job: `buffers` (the GPU buffers and bind groups), `capacity` (what an
+//! adapter holds), `pools` (the contact pools following the need),
+//! `encode` (a step's plan and dispatches), `status` (what the GPU
+//! reports), `readback`, `profile`, and the scene's records, inputs, edits
+//! and snapshots.
+
+use std::sync::Arc;
+
+use crate::gpu::status::Status;
+use crate::gpu::{types::*, Gpu};
+use crate::scene::{Scene, Settings};
+use crate::step::StepPipelines;
+use crate::Error;
+
+mod buffers;
+mod capacity;
+pub mod edit;
+mod encode;
+pub mod input;
+mod pools;
+mod profile;
+mod readback;
+mod records;
+pub mod snapshot;
+mod status;
+
+use buffers::WorldData;
+use pools::PoolWatch;
+
+pub use capacity::{
+    body_bytes, bytes_per_body, manifold_bytes, max_bodies, pair_bytes, pair_capacities, MANIFOLDS_PER_BODY, PAIRS_PER_BODY,
+};
+pub use encode::JOINT_SWEEPS_PER_SUBSTEP;
+pub use pools::SHRINK_AFTER_STEPS;
+pub use profile::StageTimes;
+pub use readback::BodyOutput;
+pub use records::{
+    body_output, body_props, initial_state, joint_gaps, joint_lists, plan_grid, scene_props, GridLayout, JointLists,
+};
+pub use status::ContactReport;
+// the limits' and faults' old home
+pub use crate::limits::{
+    Fault, FaultKind, CONTACT_MARGIN, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, MIN_SUBSTEP, NO_FAULT,
+};
+
+/// The host's side of where a batch of steps started (`World::batch_start`).
+#[derive(Clone, Copy)]
+struct BatchStart {
+    current: usize,
+    step: u64,
+    time: f64,
+    dt_prev: f32,
+}
+
+pub struct World {
+    gpu: Arc<Gpu>,
+    pipelines: StepPipelines,
+    data: WorldData,
+    settings: Settings,
+    ground: Option<f32>,
+    grid: GridLayout,
+    large_count: u32,
+    body_count: u32,
+    /// Joint islands (`joint_rest` and `solve_joints` run only when there
+    /// are any).
+    island_count: u32,
+    /// Where each colour of the joint paths begins, and after the last its
+    /// end (`JointLists::colours`): `solve_joints` runs once per colour.
+    path_colours: Vec<u32>,
+    /// Whether the bodies' speed limits (`BodyProps::speed_limit`, from the
+    /// scene's energy) still hold: no input, edit or restore since.
+    speed_limits: bool,
+    /// Which of `data.states` holds the current state.
+    current: usize,
+    step: u64,
+    time: f64,
+    /// Length of the last (sub)step taken (s): what `disp` spans.
+    dt_prev: f32,
+    /// The user-input kernels (`input.rs`), built on the first input.
+    input: Option<input::InputGpu>,
+    /// The scene as loaded or last edited (`edit.rs` rebuilds from it).
+    scene: Scene,
+    /// How full the contact pools got (`World::fit_pools`).
+    pools: PoolWatch,
+    /// Nothing moved in the last step taken and no sleeper is due to wake
+    /// (`Status::moving`, read by `fit_pools`), and no input, edit or
+    /// restore came since: every body is asleep or fixed, and each step
+    /// would leave every pose as it is, so `step_with` only counts the steps.
+    at_rest: bool,
+    /// The last step was skipped at rest: it listed no pair (nothing
+    /// moves), whatever the last step taken on the GPU left in the pools.
+    skipped: bool,
+}
+
+impl World {
+    /// Opens the default GPU and uploads the scene.
+    pub fn new(scene: &Scene) -> Result<World, Error> {
+        scene.validate()?;
+        let gpu = Arc::new(Gpu::new()?);
+        World::with_gpu(gpu, scene)
+    }
+
+    /// Uploads the scene to an already opened GPU. Refuses a scene beyond the
+    /// adapter's limits before allocating anything.
+    pub fn with_gpu(gpu: Arc<Gpu>, scene: &Scene) -> Result<World, Error> {
+        scene.validate()?;
+        let n = scene.bodies.len();
+        capacity::check_capacity(&gpu, n)?;
+        let joints = joint_lists(scene);
+        if scene.settings.sleeping {
+            capacity::check_islands(&gpu, &joints, n)?;
+        }
+        let settings = scene.settings;
+        let (props, large, grid) = scene_props(scene);
+        let states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &settings)).collect();
+        let mut data = WorldData::new(&gpu, n, &props, &states, &large, &grid, &joints, settings.substeps);
+        let (_, manifold_capacity) = pair_capacities(&gpu, n.max(1) as u64);
+        let pipelines = StepPipelines::new(&gpu, capacity::pool_in_parts(&gpu, manifold_capacity));
+        data.bind_groups = Some(data.step_bind_groups(&gpu.device, &pipelines));
+        if !large.is_empty() {
+            // the grid's part of `sorted` holds the other bodies, n - large of them
+            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("large bodies") });
+            let [large_buf, ..] = &data.statics;
+            encoder.copy_buffer_to_buffer(large_buf, 0, data.sorted(), 4 * (n - large.len()) as u64, 4 * large.len() as u64);
+            gpu.queue.submit([encoder.finish()]);
+        }
+        gpu.check()?;
+        let substep_dt = settings.dt / settings.substeps as f32;
+        Ok(World {
+            gpu,
+            pipelines,
+            data,
+            settings,
+            ground: scene.ground.as_ref().map(|g| g.height),
+            grid,
+            large_count: large.len() as u32,
+            body_count: n as u32,
+            island_count: joints.islands,
+            path_colours: joints.colours.clone(),
+            speed_limits: true,
+            current: 0,
+            step: 0,
+            time: 0.0,
+            dt_prev: substep_dt,
+            input: None,
+            scene: scene.clone(),
+            pools: PoolWatch::default(),
+            at_rest: false,
+            skipped: false,
+        })
+    }
+
+    pub fn gpu(&self) -> &Arc<Gpu> {
+        &self.gpu
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    pub fn body_count(&self) -> usize {
+        self.body_count as usize
+    }
+
+    /// Steps taken so far.
+    pub fn step_count(&self) -> u64 {
+        self.step
+    }
+
+    /// Simulated time so far (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// The grid the broadphase uses.
+    pub fn grid(&self) -> GridLayout {
+        self.grid
+    }
+
+    /// The buffer holding the current poses (for drawing without readback).
+    pub fn current_state_buffer(&self) -> &wgpu::Buffer {
+        &self.data.states[self.current]
+    }
+
+    /// Bytes of GPU memory the world's buffers hold now: what `with_gpu`
+    /// allocated, with the pair list and the manifold pool as they have
+    /// grown, and the input kernels' buffers once an input was given.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.data.bytes() + self.input.as_ref().map_or(0, |i| i.gpu_bytes())
+    }
+
+    /// Whether the world is at rest: every body asleep or fixed, none due to
+    /// wake, after the last step taken, and no input, edit or restore since.
+    /// Its steps then change no pose, and `step` skips the GPU's work,
+    /// counting only the steps and the time, until an input wakes the
+    /// bodies (a scene that never sleeps, `settings.sleeping` off, is never
+    /// at rest unless every body is fixed).
+    pub fn at_rest(&self) -> bool {
+        self.at_rest
+    }
+
+    /// Takes `steps` steps of `settings.dt`.
+    pub fn step(&mut self, steps: u64) -> Result<(), Error> {
+        let dt = self.settings.dt;
+        let mut left = steps;
+        while left > 0 {
+            if self.at_rest {
+                // nothing moves: count the steps at once, not a batch at a
+                // time (a count near u64::MAX must not loop)
+                return self.skip_at_rest(left, dt);
+            }
+            let batch = left.min(self.steps_per_batch() as u64);
+            let dts = vec![dt; batch as usize];
+            self.step_with(&dts)?;
+            left -= batch;
+        }
+        Ok(())
+    }
+
+    /// Takes one step per entry of `dts`, each of that length (s); Verlet's
+    /// time correction (eq. 11) carries the motion across changes of dt.
+    /// A lost device or any error it raised is reported here, by the next
+    /// call after it happened.
+    pub fn step_with(&mut self, dts: &[f32]) -> Result<(), Error> {
+        self.gpu.check()?;
+        for (k, &dt) in dts.iter().enumerate() {
+            if !(dt.is_finite() && dt > 0.0) {
+                return Err(Error::Input(format!("dt[{k}]: must be a positive finite number of seconds, got {dt}")));
+            }
+            if let Some(why) = crate::scene::dt_too_short(dt, self.settings.substeps) {
+                return Err(Error::Input(format!("dt[{k}]: {why}")));
+            }
+        }
+        let substeps = self.settings.substeps as usize;
+        for chunk in dts.chunks(self.steps_per_batch()) {
+            if self.at_rest {
+                // what the skipped steps would have listed: nothing moves,
+                // so no pair and no manifold (the pools follow)
+                self.skipped = true;
+                self.note_wants([0, 0], chunk.len());
+                self.shrink_pools()?;
+                self.finish_steps(chunk, substeps);
+                continue;
+            }
+            self.skipped = false;
+            self.shrink_pools()?;
+            let start = self.batch_start();
+            self.encode_and_submit(chunk, substeps);
+            // a batch whose pools overflowed is taken again once they grew:
+            // which contacts found room depended on thread timing
+            while self.fit_pools(chunk.len())? {
+                self.restore_batch_start(start);
+                self.encode_and_submit(chunk, substeps);
+            }
+        }
+        Ok(())
+    }
+
+    /// Where the next batch starts from, on the host's side: which state
+    /// buffer is current, the step count, the time and the last substep's
+    /// length (the GPU's side is copied by `copy_batch_start`).
+    fn batch_start(&self) -> BatchStart {
+        BatchStart { current: self.current, step: self.step, time: self.time, dt_prev: self.dt_prev }
+    }
+
+    /// Puts the world back where a batch started (`batch_start` and the
+    /// copies `copy_batch_start` made), to take the batch again.
+    fn restore_batch_start(&mut self, start: BatchStart) {
+        let BatchStart { current, step, time, dt_prev } = start;
+        (self.current, self.step, self.time, self.dt_prev) = (current, step, time, dt_prev);
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("redo batch") });
+        let [state, status] = &self.data.batch_start;
+        // into both state buffers: a body the step leaves as it is holds the
+        // same in both (`listed_body` in bindings.wgsl)
+        for to in &self.data.states {
+            encoder.copy_buffer_to_buffer(state, 0, to, 0, state.size());
+        }
+        encoder.copy_buffer_to_buffer(status, 0, &self.data.status, 0, Status::BYTES);
+        self.gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Counts `steps` steps of `dt` of a world at rest (`at_rest`): what
+    /// `step_with` does for each batch of them, in one go.
+    fn skip_at_rest(&mut self, steps: u64, dt: f32) -> Result<(), Error> {
+        self.skipped = true;
+        self.note_wants([0, 0], usize::try_from(steps).unwrap_or(usize::MAX));
+        self.shrink_pools()?;
+        self.dt_prev = dt / self.settings.substeps as f32;
+        self.step = self.step.saturating_add(steps);
+        self.time += steps as f64 * dt as f64;
+        Ok(())
+    }
+
+    /// Advances the host's step count, time and last substep past `dts`.
+    fn finish_steps(&mut self, dts: &[f32], substeps: usize) {
+        self.dt_prev = dts.last().map_or(self.dt_prev, |&dt| dt / substeps as f32);
+        self.step += dts.len() as u64;
+        self.time += dts.iter().map(|&d| d as f64).sum::<f64>();
+    }
+}
