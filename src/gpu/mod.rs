@@ -83,15 +83,9 @@ impl Gpu {
         bind_groups: Option<&[&wgpu::BindGroupLayout]>,
         constants: &[(&str, f64)],
     ) -> Vec<wgpu::ComputePipeline> {
-        // Without wgpu's loop bounding: it gives every loop a counter of its
-        // own that breaks out after 2^64 trips, which keeps LLVM from
-        // unrolling even a loop of fixed length, so lavapipe kept the
-        // separating-axis test's loops rolled and their small arrays in
-        // memory (`narrowphase` 3.0 -> 2.0 ms on a landed pile of 10k
-        // cubes, the same bits). Every loop here ends: a counter stepped
-        // towards a bound fixed before the loop, which the test
-        // `shaders::every_loop_counts_to_a_bound` holds every kernel to.
-        // Bounds checks and integer division checks stay.
+        // Without wgpu's loop bounding, whose per-loop counter keeps LLVM
+        // from unrolling fixed loops (docs/lavapipe.md); every loop here ends
+        // (`shaders::every_loop_counts_to_a_bound`). Bounds checks stay.
         let checks = wgpu::ShaderRuntimeChecks { force_loop_bounding: false, ..wgpu::ShaderRuntimeChecks::checked() };
         let descriptor = wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) };
         // SAFETY: wgpu asks that no loop of a module made without loop

@@ -74,22 +74,11 @@ pub fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
 }
 
 /// Refuses a step so long that bodies would rest visibly inside the ground,
-/// or sink through it. Gravity moves a body |g| h^2 into whatever it rests
-/// on every substep of h, and the substep's k Jacobi sweeps relaxed by c_r
-/// take back all but (1 - c_r)^k of it (k the fewest sweeps a substep
-/// takes, `Settings::sweeps`), so that much stays inside,
-/// every substep, and a body rests (and falls asleep) there: measured, unit
-/// cubes came to rest 6 mm inside the ground at dt 0.2 s, 39 mm at 0.5 s
-/// and 156 mm at 1 s (3 substeps, 3 sweeps, c_r 0.5), as the formula says.
-/// The limit is a tenth of the smallest moving body's bounding radius. What
-/// stays inside is old overlap by the next substep, which the solve pushes
-/// out at no more than `MAX_DEPENETRATION_SPEED` (3 m/s) times h: where
-/// more stays, it adds up and the body sinks through the ground. Measured
-/// at the default dt, a unit box rested 2.7 cm inside at 5000 m/s^2 and
-/// fell through at 6000 (1.2 m below in 4 s), where (1 - c_r)^k
-/// |g| h is 3.5 and 4.2 m/s; this refuses from 3 m/s (4320 m/s^2 there).
-/// Only gravity's part into the ground (along -y) counts: sideways or
-/// upward it presses nothing into it.
+/// or sink through it: each substep gravity presses a body |g| h^2 into what
+/// it rests on and the sweeps leave (1 - c_r)^k of that; refused where that
+/// passes a tenth of the smallest moving body's bounding radius, or where it
+/// pushes in faster than `MAX_DEPENETRATION_SPEED` pushes out (figures in
+/// docs/limits.md). Only gravity's part along -y counts.
 pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError> {
     let Some(smallest) = bodies.iter().filter(|b| !b.fixed).map(|b| b.bounding_radius()).reduce(f32::min) else {
         return Ok(());
@@ -296,14 +285,8 @@ pub(super) fn validate_camera(camera: &Camera) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// The smallest bounding radius (m) a body may have. Measured on lavapipe,
-/// dropped from 1 m with restitution 0.5 at three tilts and the default
-/// settings: spheres of radius 6 mm and less sank more than their radius
-/// into the ground and spun up to 270-320 rad/s from rounding (their inverse
-/// inertia is huge, so a lever arm off by a rounding error turns them), a
-/// cube of half extent 5 mm sank 1.1 cm, and a tilted 2.5 mm cube bounced to
-/// 0.34 m where 0.25 m is the most restitution allows; from 7.5 mm up every
-/// one landed, bounced at most 0.25 m and stopped turning.
+/// The smallest bounding radius (m) a body may have: below about 7.5 mm
+/// rounding spins, sinks and over-bounces bodies (docs/limits.md).
 pub const MIN_BOUNDING_RADIUS: f32 = 0.01;
 
 pub(super) fn check_shape(shape: &Shape, path: &str) -> Result<(), SceneError> {
