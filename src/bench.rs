@@ -223,8 +223,10 @@ impl CopyKernel {
     }
 }
 
-// ---------------------------------------------------------------------------
-// The rapier3d peer
+/// A case spec refused, naming the argument.
+fn case_error(reason: String) -> Error {
+    Error::Argument { name: "spec", reason }
+}
 
 #[cfg(test)]
 mod tests {
@@ -250,9 +252,4 @@ mod tests {
         assert!(err.contains("the drop scene takes no count"), "{err}");
         assert_eq!(Case::parse("drop").unwrap().count, None);
     }
-}
-
-/// A case spec refused, naming the argument.
-fn case_error(reason: String) -> Error {
-    Error::Argument { name: "spec", reason }
 }

@@ -14,23 +14,65 @@
 //! println!("box at {:?}", bodies[0].position);
 //! # Ok::<(), verlet::Error>(())
 //! ```
+//!
+//! Where to start:
+//!
+//! - A [`Scene`] (its [`Body`]s with their [`Shape`]s, [`Joint`]s, the
+//!   [`Ground`], [`Settings`] and [`Camera`]) is built in code, loaded with
+//!   [`Scene::from_path`], or taken from the built-in [`scenes`].
+//! - [`World::new`] puts a scene on the GPU ([`World::with_gpu`] shares one
+//!   [`Gpu`]); [`World::step`] steps it and [`World::read_state`] reads each
+//!   body back as a [`BodyOutput`]. Every call fails with one [`Error`].
+//! - Inputs act between steps: [`World::apply_impulse`], [`World::set_pose`],
+//!   [`World::explode`], [`World::apply_wind`] with a [`Wind`], or a list of
+//!   [`BodyInput`]s; a [`Track`] of timed [`Event`]s replays them.
+//! - [`World::snapshot`] and [`World::restore`] save and resume a run
+//!   bit for bit ([`Snapshot`]).
+//! - [`render::Renderer`] draws a world off-screen into an image.
+//! - What a world reports: [`World::faults`] ([`Fault`]),
+//!   [`World::contact_report`] ([`ContactReport`]), [`World::profile`]
+//!   ([`StageTimes`]), [`World::read_contacts`] ([`BodyContact`]).
+//!
+//! The [`output`] module writes the state and trace formats of the command
+//! line; [`limits`] holds the physics limits a world checks bodies against.
 
-pub mod bench;
+// The modules a user reaches by path; their main types are also re-exported
+// below.
 pub mod gpu;
-mod json;
 pub mod limits;
 pub mod load_error;
 pub mod output;
-pub mod reference;
 pub mod render;
 pub mod scene;
 pub mod scenes;
-pub mod step;
 pub mod track;
+
+mod json;
+
+// For the binary's `bench` command and the benches, not part of the guide.
+#[doc(hidden)]
+pub mod bench;
+// For the crate's own tests: CPU twins of the kernels.
+#[doc(hidden)]
+pub mod reference;
+// For the crate's own tests and the binary: the step's stages and buffers.
+#[doc(hidden)]
+pub mod step;
+// For the crate's own tests and the binary: the world's internals by path;
+// users reach its types at the crate root.
+#[doc(hidden)]
 pub mod world;
 
-pub use scene::{Body, Ground, Joint, Scene, SceneError, Settings, Shape};
-pub use world::{BodyOutput, World};
+pub use gpu::types::BodyContact;
+pub use gpu::{Gpu, GpuError};
+pub use limits::{Fault, FaultKind};
+pub use load_error::LoadError;
+pub use render::{RenderOptions, Renderer};
+pub use scene::{Body, Camera, Ground, Joint, Scene, SceneError, Settings, Shape, WORLD};
+pub use track::{Action, Event, Track, TrackError};
+pub use world::input::{BodyInput, Point, Wind};
+pub use world::snapshot::Snapshot;
+pub use world::{max_bodies, BodyOutput, ContactReport, StageTimes, World};
 
 /// Everything that can go wrong, each with a one-line reason.
 #[derive(Debug, thiserror::Error)]

@@ -71,7 +71,7 @@ pub struct Fault {
 impl Fault {
     /// The fault the GPU's two words describe (`Status::fault`: 8 x body +
     /// kind; `Status::fault_step`), if any.
-    pub fn decode(code: u32, step: u32) -> Option<Fault> {
+    pub(crate) fn decode(code: u32, step: u32) -> Option<Fault> {
         if step == NO_FAULT || code == NO_FAULT {
             return None;
         }

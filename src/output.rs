@@ -54,7 +54,7 @@ fn io_err(path: &Path, source: std::io::Error) -> Error {
 
 /// An output file written beside its destination under a hidden temporary
 /// name (`.NAME.verlet-PID.tmp`, or `.NAME.verlet-PID-K.tmp` where that is
-/// taken: [`hidden_name`]), created new, and renamed over the destination
+/// taken: `hidden_name`), created new, and renamed over the destination
 /// only when complete ([`AtomicFile::commit`]): a failed or killed run never
 /// leaves a half-written file where a whole one was expected, nor destroys
 /// the file that was there. Dropped uncommitted, the temporary file is
@@ -239,12 +239,12 @@ impl Drop for AtomicFile {
 }
 
 /// The most hidden names [`create_hidden`] tries for one file.
-pub const HIDDEN_TRIES: u32 = 100;
+pub(crate) const HIDDEN_TRIES: u32 = 100;
 
 /// The `k`-th name [`create_hidden`] tries in `dir` for a file of this
 /// process beside `name`: `.NAME.verlet-PID.EXT`, then
 /// `.NAME.verlet-PID-K.EXT` for k = 1, 2, ...
-pub fn hidden_name(dir: &Path, name: &std::ffi::OsStr, k: u32, ext: &str) -> PathBuf {
+pub(crate) fn hidden_name(dir: &Path, name: &std::ffi::OsStr, k: u32, ext: &str) -> PathBuf {
     let pid = std::process::id();
     let name = name.to_string_lossy();
     match k {
@@ -253,7 +253,7 @@ pub fn hidden_name(dir: &Path, name: &std::ffi::OsStr, k: u32, ext: &str) -> Pat
     }
 }
 
-/// Creates a new file in `dir` under the first free [`hidden_name`],
+/// Creates a new file in `dir` under the first free `hidden_name`,
 /// opened for reading and writing. Each name is created new (`O_EXCL`),
 /// which refuses any name already taken, a symbolic link included, so a
 /// link planted at the predictable name is never followed: the temporary

@@ -1,8 +1,15 @@
-//! The GPU context (instance, adapter, device, queue), the structs shared
-//! with WGSL, and shader assembly.
+//! The GPU context a world runs on ([`Gpu`]: instance, adapter, device,
+//! queue; one may serve several worlds and renderers), and why none could
+//! be had ([`GpuError`]). The structs shared with WGSL and the shader
+//! assembly live here too, for the crate itself and its tests.
 
+// For the crate's own tests: the WGSL sources, the GPU's status record and
+// the records shared with WGSL, checked against the shaders.
+#[doc(hidden)]
 pub mod shaders;
+#[doc(hidden)]
 pub mod status;
+#[doc(hidden)]
 pub mod types;
 
 use std::fmt;
@@ -35,7 +42,7 @@ pub enum GpuError {
 /// The longest `Gpu::wait` waits for submitted work before giving up with
 /// `GpuError::Timeout`. Generous: one submission is at most a batch of
 /// steps, which on a software adapter with a huge scene takes seconds.
-pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(300);
+pub(crate) const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(300);
 
 /// `Gpu::wait` polls in slices of this length, checking for a lost device
 /// between them.
@@ -75,6 +82,8 @@ impl Gpu {
     /// the input kernels, the bench's copy kernel). `bind_groups`: the
     /// layouts of its bind groups, or None to take them from the shader
     /// (`get_bind_group_layout`); `constants`: override constants.
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
     pub fn compute_pipelines(
         &self,
         label: &str,
@@ -212,6 +221,8 @@ impl Gpu {
     /// (llvmpipe) ends every loop of an invocation once their trips sum to
     /// 65535 (gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`), silently; this
     /// leaves a margin below it. `None` where no such limit is known.
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
     pub fn loop_trips(&self) -> Option<u32> {
         self.info.name.contains("llvmpipe").then_some(65_000)
     }
@@ -258,7 +269,7 @@ impl Gpu {
     }
 
     /// Copies `size` bytes of `src` to the host (a blocking readback).
-    pub fn read_buffer(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
+    pub(crate) fn read_buffer(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
@@ -369,7 +380,7 @@ fn check_env() -> Result<(), GpuError> {
 
 /// GPU timestamps around a run of compute passes: pass k writes queries 2k
 /// and 2k + 1, resolved at the end of the encoder and read back as ms.
-pub struct PassTimer {
+pub(crate) struct PassTimer {
     set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
     passes: u32,
@@ -377,7 +388,7 @@ pub struct PassTimer {
 
 impl PassTimer {
     /// Needs `Features::TIMESTAMP_QUERY`.
-    pub fn new(gpu: &Gpu, label: &str, passes: usize) -> PassTimer {
+    pub(crate) fn new(gpu: &Gpu, label: &str, passes: usize) -> PassTimer {
         let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some(label),
             ty: wgpu::QueryType::Timestamp,
@@ -393,7 +404,7 @@ impl PassTimer {
     }
 
     /// The timestamp writes of pass `k`.
-    pub fn writes(&self, k: usize) -> wgpu::ComputePassTimestampWrites<'_> {
+    pub(crate) fn writes(&self, k: usize) -> wgpu::ComputePassTimestampWrites<'_> {
         wgpu::ComputePassTimestampWrites {
             query_set: &self.set,
             beginning_of_pass_write_index: Some(2 * k as u32),
@@ -402,12 +413,12 @@ impl PassTimer {
     }
 
     /// Resolves every pass's queries at the end of `encoder`.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+    pub(crate) fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.resolve_query_set(&self.set, 0..2 * self.passes, &self.resolve, 0);
     }
 
     /// Each pass's duration (ms), once the encoder has been submitted.
-    pub fn read_ms(&self, gpu: &Gpu) -> Result<Vec<f64>, GpuError> {
+    pub(crate) fn read_ms(&self, gpu: &Gpu) -> Result<Vec<f64>, GpuError> {
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&gpu.read_buffer(&self.resolve, 16 * self.passes as u64)?);
         let period_ms = gpu.queue.get_timestamp_period() as f64 * 1e-6;
         Ok((0..self.passes as usize).map(|k| ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period_ms).collect())

@@ -67,7 +67,7 @@ pub fn shared_constants() -> String {
 }
 
 /// `const NAME: u32 = value;` in WGSL.
-pub fn wgsl_u32(name: &str, value: u32) -> String {
+pub(crate) fn wgsl_u32(name: &str, value: u32) -> String {
     format!("const {name}: u32 = {value}u;\n")
 }
 
@@ -78,12 +78,12 @@ pub fn wgsl_f32(name: &str, value: f32) -> String {
 }
 
 /// The pieces of the step's passes' modules, in order (see `Stage::pieces`).
-pub const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
-pub const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
-pub const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE];
-pub const INTEGRATE_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION, INTEGRATE];
-pub const SOLVE_PASS: &[&str] = &[COMMON, BINDINGS, SOLVE];
-pub const RESTITUTION_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION];
+pub(crate) const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
+pub(crate) const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
+pub(crate) const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, NARROWPHASE];
+pub(crate) const INTEGRATE_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION, INTEGRATE];
+pub(crate) const SOLVE_PASS: &[&str] = &[COMMON, BINDINGS, SOLVE];
+pub(crate) const RESTITUTION_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION];
 
 /// Parses and validates WGSL with naga, as the device would.
 pub fn validate(source: &str) -> Result<naga::Module, String> {

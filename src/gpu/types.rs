@@ -277,7 +277,7 @@ pub struct JointRef {
 /// [`WAKES`] bit by the step's integration; the sleeper wakes at the next
 /// step. A snapshot's wake flags name the two `WOKEN_NOW` and `WOKEN_LAST`.
 pub const WOKEN_NOW: u32 = 1;
-pub const WOKEN_LAST: u32 = 2;
+pub(crate) const WOKEN_LAST: u32 = 2;
 
 /// The partner of a joint pinned to the world (`WORLD` in WGSL).
 pub const WORLD: u32 = u32::MAX;
@@ -311,4 +311,4 @@ pub const WORKGROUP: u32 = 64;
 
 /// Byte stride between the per-step `Params` slots of a batch: the
 /// uniform-buffer offset alignment WebGPU guarantees to work everywhere.
-pub const PARAMS_STRIDE: u64 = 256;
+pub(crate) const PARAMS_STRIDE: u64 = 256;

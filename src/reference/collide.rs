@@ -74,7 +74,7 @@ fn flip(m: &Manifold) -> Manifold {
     Manifold { normal: -m.normal, points: m.points.iter().map(|p| ContactPoint { on_a: p.on_b, on_b: p.on_a }).collect() }
 }
 
-pub fn sphere_sphere(ca: Vec3, ra: f32, cb: Vec3, rb: f32, margin: f32) -> Option<Manifold> {
+pub(crate) fn sphere_sphere(ca: Vec3, ra: f32, cb: Vec3, rb: f32, margin: f32) -> Option<Manifold> {
     let d = cb - ca;
     let dist = d.length();
     if dist - ra - rb > margin {
@@ -85,7 +85,7 @@ pub fn sphere_sphere(ca: Vec3, ra: f32, cb: Vec3, rb: f32, margin: f32) -> Optio
 }
 
 /// Box first, sphere second: the normal points from the box to the sphere.
-pub fn box_sphere(cb: Vec3, rot: Quat, h: Vec3, cs: Vec3, r: f32, margin: f32) -> Option<Manifold> {
+pub(crate) fn box_sphere(cb: Vec3, rot: Quat, h: Vec3, cs: Vec3, r: f32, margin: f32) -> Option<Manifold> {
     let local = rot.conjugate() * (cs - cb);
     let closest = local.clamp(-h, h);
     let outside = local - closest;

@@ -60,7 +60,7 @@ pub(super) fn joint_lines(scene: &Scene) -> Vec<JointLine> {
 
 /// Body `index`'s colour (sRGB): hues a golden angle apart, so neighbours in
 /// a scene differ and no two of the first dozen look alike; body 0 is red.
-pub fn body_color(index: usize) -> [f32; 3] {
+pub(crate) fn body_color(index: usize) -> [f32; 3] {
     let hue = (index as f64 * 0.618_033_988_749_895).fract() as f32;
     hsv_to_rgb(hue, 0.6, 0.9)
 }

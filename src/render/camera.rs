@@ -15,7 +15,7 @@ const SHADOW_REACH: f32 = 1.5;
 /// Where the default camera looks from, relative to the scene's centre:
 /// above, in front and a little to the right, so three faces of an
 /// axis-aligned box show, each lit differently.
-pub const DEFAULT_VIEW_DIRECTION: [f32; 3] = [0.6, 0.5, 1.0];
+pub(crate) const DEFAULT_VIEW_DIRECTION: [f32; 3] = [0.6, 0.5, 1.0];
 /// The default camera leaves this much room around the scene's bounding
 /// sphere (a factor on the distance that just fits it).
 const FRAMING_MARGIN: f32 = 1.05;

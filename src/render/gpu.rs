@@ -12,7 +12,7 @@ use crate::gpu::Gpu;
 use crate::Error;
 
 /// shaders/render.wgsl, the render pipelines' own part.
-pub const RENDER: &str = include_str!("../../shaders/render.wgsl");
+pub(crate) const RENDER: &str = include_str!("../../shaders/render.wgsl");
 
 /// The WGSL of every render pipeline: the shared constants, common.wgsl (the
 /// body's pose and the quaternion helpers; it binds nothing), render.wgsl.
@@ -21,7 +21,7 @@ pub fn shader_source() -> String {
 }
 
 /// Samples per pixel: 4x MSAA, which WebGPU guarantees for both formats below.
-pub const SAMPLES: u32 = 4;
+pub(crate) const SAMPLES: u32 = 4;
 /// The image: 8-bit sRGB, so shading happens in linear light and the bytes
 /// read back are what a PNG expects.
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -80,7 +80,7 @@ pub struct JointLine {
 }
 
 /// The compiled render pipelines and their bind-group layouts; nothing else.
-pub struct RenderPipelines {
+pub(crate) struct RenderPipelines {
     /// Group 0: globals, states, bodies, joints.
     pub layout: wgpu::BindGroupLayout,
     /// Group 1: the shadow map and its comparison sampler (main pass only).
@@ -92,7 +92,7 @@ pub struct RenderPipelines {
 }
 
 impl RenderPipelines {
-    pub fn new(device: &wgpu::Device) -> RenderPipelines {
+    pub(crate) fn new(device: &wgpu::Device) -> RenderPipelines {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render.wgsl"),
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
@@ -240,7 +240,7 @@ impl RenderPipelines {
 }
 
 /// The renderer's buffers and textures, all made once at start-up.
-pub struct RenderData {
+pub(crate) struct RenderData {
     pub globals: wgpu::Buffer,
     /// `RenderBody` per body, boxes first, then spheres.
     pub bodies: wgpu::Buffer,

@@ -1,7 +1,7 @@
 //! Off-screen rendering of a [`World`]: shaded bodies, the ground with a
 //! grid, optional joint lines, from a fixed camera that frames the scene.
 //!
-//! The bodies are drawn straight from [`World::current_state_buffer`], bound
+//! The bodies are drawn straight from the world's current state buffer, bound
 //! read-only in the vertex shader (`shaders/render.wgsl`): nothing is read
 //! back to draw, only the finished image is. What never changes (each body's
 //! shape, size and colour) is uploaded once from the [`Scene`].
@@ -23,8 +23,8 @@
 //! readback); `camera.rs` the maths of where a frame is seen from and lit;
 //! `bodies.rs` what each body looks like; `mesh.rs` the unit meshes;
 //! `files.rs` images to files. As the step splits pipelines from buffers,
-//! [`RenderPipelines`] holds only what is compiled (built once, in
-//! [`Renderer::new`]) and [`RenderData`] only buffers and textures; a frame
+//! `RenderPipelines` holds only what is compiled (built once, in
+//! [`Renderer::new`]) and `RenderData` only buffers and textures; a frame
 //! allocates nothing but, the first time it sees each of a world's two
 //! state buffers, a bind group for it.
 
@@ -34,10 +34,12 @@ mod files;
 mod gpu;
 mod mesh;
 
-pub use bodies::body_color;
-pub use camera::{CameraView, DEFAULT_VIEW_DIRECTION};
+pub use camera::CameraView;
 pub use files::{contact_sheet, write_gif, write_png};
-pub use gpu::{shader_source, Globals, JointLine, RenderBody, RenderData, RenderPipelines, RENDER, SAMPLES};
+// For the crate's own tests: the WGSL and the records it reads, checked
+// against each other.
+#[doc(hidden)]
+pub use gpu::{shader_source, Globals, JointLine, RenderBody};
 
 use glam::{Mat4, Vec4};
 use image::RgbaImage;

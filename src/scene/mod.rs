@@ -35,7 +35,7 @@ pub const DEFAULT_DENSITY: f32 = 1000.0;
 pub const WORLD: i32 = -1;
 
 /// Identity rotation, `[x, y, z, w]`.
-pub const IDENTITY_ORIENTATION: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
+pub(crate) const IDENTITY_ORIENTATION: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
 
 /// The most relaxation iterations a step may ask for.
 pub const MAX_ITERATIONS: u32 = 256;
@@ -371,4 +371,4 @@ mod write;
 use load::*;
 use validate::*;
 
-pub use validate::{dt_too_short, mass_problem, position_problem, speed_problem, spin_problem, MIN_BOUNDING_RADIUS};
+pub(crate) use validate::{dt_too_short, mass_problem, position_problem, speed_problem, spin_problem};

@@ -59,7 +59,7 @@ pub(super) fn validate_settings(s: &Settings) -> Result<(), SceneError> {
 /// Why a step of `dt` s in `substeps` substeps is too short, if it is
 /// (`limits::MIN_SUBSTEP`; a part in a million below it is let by, so 3e-5 s
 /// in 3 substeps passes).
-pub fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
+pub(crate) fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
     let h = dt as f64 / substeps.max(1) as f64;
     (h < crate::limits::MIN_SUBSTEP as f64 * (1.0 - 1e-6)).then(|| {
         format!(
@@ -126,7 +126,7 @@ fn length(v: [f32; 3]) -> f64 {
 
 /// Why a body placed at `p` (m) is absurd, if it is: farther than
 /// `limits::MAX_DISTANCE` from the origin, where the step stops it as a fault.
-pub fn position_problem(p: [f32; 3]) -> Option<String> {
+pub(crate) fn position_problem(p: [f32; 3]) -> Option<String> {
     use crate::limits::MAX_DISTANCE;
     let distance = length(p);
     (distance > MAX_DISTANCE as f64).then(|| {
@@ -136,7 +136,7 @@ pub fn position_problem(p: [f32; 3]) -> Option<String> {
 
 /// Why a body moving at `v` (m/s) is absurd, if it is: faster than
 /// `limits::MAX_SPEED`, where the step stops it as a fault.
-pub fn speed_problem(v: [f32; 3]) -> Option<String> {
+pub(crate) fn speed_problem(v: [f32; 3]) -> Option<String> {
     use crate::limits::MAX_SPEED;
     let speed = length(v);
     (speed > MAX_SPEED as f64)
@@ -147,7 +147,7 @@ pub fn speed_problem(v: [f32; 3]) -> Option<String> {
 /// any), if it is: faster than `limits::MAX_SPIN`, or turning more than
 /// `limits::MAX_TURN` in one substep, which a pose pair cannot hold (the
 /// numerical-fault check of integrate.wgsl would stop the body).
-pub fn spin_problem(w: [f32; 3], h: f32) -> Option<String> {
+pub(crate) fn spin_problem(w: [f32; 3], h: f32) -> Option<String> {
     use crate::limits::{MAX_SPIN, MAX_TURN};
     let rate = w.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
     if rate > MAX_SPIN as f64 {
@@ -196,7 +196,7 @@ pub(super) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Res
 
 /// Why `mass` (kg) is unusable for a movable body of `shape`, if it is (see
 /// `inverse_problem`): what an input that makes a body dynamic is checked by.
-pub fn mass_problem(shape: &Shape, mass: f32) -> Option<String> {
+pub(crate) fn mass_problem(shape: &Shape, mass: f32) -> Option<String> {
     if !(mass.is_finite() && mass > 0.0) {
         return Some(format!("must be a positive finite number of kg, got {}", show(mass)));
     }
@@ -287,7 +287,7 @@ pub(super) fn validate_camera(camera: &Camera) -> Result<(), SceneError> {
 
 /// The smallest bounding radius (m) a body may have: below about 7.5 mm
 /// rounding spins, sinks and over-bounces bodies (docs/limits.md).
-pub const MIN_BOUNDING_RADIUS: f32 = 0.01;
+pub(crate) const MIN_BOUNDING_RADIUS: f32 = 0.01;
 
 pub(super) fn check_shape(shape: &Shape, path: &str) -> Result<(), SceneError> {
     let field = match *shape {

@@ -46,8 +46,8 @@ pub fn large_pyramid(rows: usize) -> Scene {
 }
 
 /// Rows of each pyramid of `many_pyramids` (Box3D's `baseCount`), and its cubes.
-pub const SMALL_PYRAMID_ROWS: usize = 10;
-pub const SMALL_PYRAMID_BOXES: usize = SMALL_PYRAMID_ROWS * (SMALL_PYRAMID_ROWS + 1) / 2;
+const SMALL_PYRAMID_ROWS: usize = 10;
+pub(crate) const SMALL_PYRAMID_BOXES: usize = SMALL_PYRAMID_ROWS * (SMALL_PYRAMID_ROWS + 1) / 2;
 
 /// `many_pyramids`: Box3D's benchmark of that name, `side` x `side`
 /// pyramids (Box3D: 14 x 14 = 196) of `SMALL_PYRAMID_ROWS` rows (55 unit

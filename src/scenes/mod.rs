@@ -9,7 +9,8 @@
 mod box3d;
 mod build;
 
-pub use box3d::{joint_grid, large_pyramid, many_pyramids, SMALL_PYRAMID_BOXES, SMALL_PYRAMID_ROWS};
+use box3d::SMALL_PYRAMID_BOXES;
+pub use box3d::{joint_grid, large_pyramid, many_pyramids};
 pub use build::{
     blast, blast_track, box_body, bridge, chain, cubes, drop, hanging, pile, pyramid, ragdoll, sphere, sphere_body, stack,
 };

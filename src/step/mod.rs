@@ -30,5 +30,6 @@ mod pipelines;
 mod stages;
 
 pub use buffers::Buffer;
-pub use pipelines::{storage_buffers, StepPipelines};
-pub use stages::{Over, Part, Poses, Runs, Stage, StageInfo, TABLE};
+pub(crate) use pipelines::{storage_buffers, StepPipelines};
+pub(crate) use stages::{Over, Poses, Runs};
+pub use stages::{Part, Stage};

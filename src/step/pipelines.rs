@@ -5,7 +5,7 @@ use crate::gpu::{types::Params, Gpu};
 
 /// The most storage buffers any stage binds; the device must allow this
 /// many per shader stage.
-pub fn storage_buffers() -> u32 {
+pub(crate) fn storage_buffers() -> u32 {
     Stage::ALL.iter().map(|s| s.buffers().iter().filter(|b| **b != Buffer::Params).count() as u32).max().unwrap_or(0)
 }
 
@@ -13,7 +13,7 @@ pub fn storage_buffers() -> u32 {
 /// buffers its entry point uses: every pass of the step binds fewer than
 /// the 16 storage buffers an adapter is asked for, though the step has
 /// more).
-pub struct StepPipelines {
+pub(crate) struct StepPipelines {
     layouts: Vec<wgpu::BindGroupLayout>,
     pipelines: Vec<wgpu::ComputePipeline>,
     /// Compiled for a manifold pool in parts (POOL_SPLIT in bindings.wgsl).
@@ -57,7 +57,7 @@ fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: 
 impl StepPipelines {
     /// Compiles the step's passes, for a manifold pool in parts where
     /// `pool_split` (see `World::make_pools`).
-    pub fn new(gpu: &Gpu, pool_split: bool) -> StepPipelines {
+    pub(crate) fn new(gpu: &Gpu, pool_split: bool) -> StepPipelines {
         let device = &gpu.device;
         let layouts: Vec<wgpu::BindGroupLayout> = Stage::ALL
             .iter()
@@ -72,7 +72,7 @@ impl StepPipelines {
 
     /// Compiles the passes that touch the manifold pool's parts again, for
     /// a pool in parts (POOL_SPLIT on; see `World::make_pools`).
-    pub fn split_pool(&mut self, gpu: &Gpu) {
+    pub(crate) fn split_pool(&mut self, gpu: &Gpu) {
         for stage in Stage::ALL {
             let buffers = stage.buffers();
             if buffers.contains(&Buffer::Points) || buffers.contains(&Buffer::Snaps1) {
@@ -82,11 +82,11 @@ impl StepPipelines {
         self.pool_split = true;
     }
 
-    pub fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {
+    pub(crate) fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {
         &self.pipelines[stage as usize]
     }
 
-    pub fn layout(&self, stage: Stage) -> &wgpu::BindGroupLayout {
+    pub(crate) fn layout(&self, stage: Stage) -> &wgpu::BindGroupLayout {
         &self.layouts[stage as usize]
     }
 }

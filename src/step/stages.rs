@@ -34,7 +34,7 @@ pub enum Stage {
 
 /// What one invocation of a stage works on, which sizes its dispatch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Over {
+pub(crate) enum Over {
     Bodies,
     Buckets,
     /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` buckets.
@@ -62,7 +62,7 @@ pub enum Over {
 
 /// What a stage does with the pose buffers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Poses {
+pub(crate) enum Poses {
     /// Reads the current state only.
     Read,
     /// Reads the current state and writes the other (state_out), which then
@@ -76,7 +76,7 @@ pub enum Poses {
 
 /// When a stage runs within a step (`World::step_plan`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Runs {
+pub(crate) enum Runs {
     /// Once a step, before the substeps, in the table's order.
     EachStep,
     /// Once a step, where the grid's scan spans more than one block of
@@ -101,7 +101,7 @@ pub enum Part {
 
 /// One row of the table: a stage as the host sees it.
 #[derive(Clone, Copy, Debug)]
-pub struct StageInfo {
+pub(crate) struct StageInfo {
     pub stage: Stage,
     /// The label of its compute pass and its bind group.
     pub name: &'static str,
@@ -151,7 +151,7 @@ impl StageInfo {
 }
 
 /// Every stage, in the order of `Stage` (checked as the table is built).
-pub const TABLE: [StageInfo; 21] = {
+pub(crate) const TABLE: [StageInfo; 21] = {
     use shaders::{GRID_PASS, INTEGRATE_PASS, NARROWPHASE_PASS, PAIRS_PASS, RESTITUTION_PASS, SOLVE_PASS};
     use Buffer::*;
     use Part::{Broadphase, Narrowphase};
@@ -333,7 +333,7 @@ impl Stage {
     };
 
     /// Its row of the table.
-    pub fn info(self) -> &'static StageInfo {
+    pub(crate) fn info(self) -> &'static StageInfo {
         &TABLE[self as usize]
     }
 
@@ -346,7 +346,7 @@ impl Stage {
         self.info().entry_point
     }
 
-    pub fn pieces(self) -> &'static [&'static str] {
+    pub(crate) fn pieces(self) -> &'static [&'static str] {
         self.info().pieces
     }
 
@@ -365,15 +365,15 @@ impl Stage {
 
     /// The buffers it binds (what it reads or writes), by binding: its bind
     /// group layout holds these alone.
-    pub fn buffers(self) -> Vec<Buffer> {
+    pub(crate) fn buffers(self) -> Vec<Buffer> {
         Buffer::ALL.iter().copied().filter(|b| self.reads().contains(b) || self.writes().contains(b)).collect()
     }
 
-    pub fn over(self) -> Over {
+    pub(crate) fn over(self) -> Over {
         self.info().over
     }
 
-    pub fn poses(self) -> Poses {
+    pub(crate) fn poses(self) -> Poses {
         self.info().poses
     }
 

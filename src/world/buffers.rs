@@ -87,7 +87,7 @@ impl WorldData {
     /// Makes and fills the buffers of a scene of `n` bodies (`props`,
     /// `states`, the bodies kept out of the grid `large`, `joints`).
     #[allow(clippy::too_many_arguments)]
-    pub fn new(
+    pub(crate) fn new(
         gpu: &Gpu,
         n: usize,
         props: &[BodyProps],
@@ -168,13 +168,13 @@ impl WorldData {
 
     /// `sorted`: the grid's order, then the bodies the step's body passes
     /// run over.
-    pub fn sorted(&self) -> &wgpu::Buffer {
+    pub(crate) fn sorted(&self) -> &wgpu::Buffer {
         &self.scratch[4]
     }
 
     /// The buffer bound at `buffer`'s binding while `states[from]` is the
     /// current state (state_in) and the other the next (state_out).
-    pub fn buffer(&self, buffer: Buffer, from: usize) -> &wgpu::Buffer {
+    pub(crate) fn buffer(&self, buffer: Buffer, from: usize) -> &wgpu::Buffer {
         let [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds] = &self.scratch;
         let [_, joint_start, joint_refs] = &self.statics;
         match buffer {
@@ -206,7 +206,7 @@ impl WorldData {
 
     /// Every stage's two bind groups (its buffers, `Stage::buffers`), by
     /// stage: `[k]` reads `states[k]` and writes `states[1 - k]`.
-    pub fn step_bind_groups(&self, device: &wgpu::Device, pipelines: &StepPipelines) -> Vec<[wgpu::BindGroup; 2]> {
+    pub(crate) fn step_bind_groups(&self, device: &wgpu::Device, pipelines: &StepPipelines) -> Vec<[wgpu::BindGroup; 2]> {
         let group = |stage: Stage, from: usize| {
             let entries: Vec<wgpu::BindGroupEntry> = stage
                 .buffers()
@@ -233,7 +233,7 @@ impl WorldData {
     }
 
     /// Bytes of GPU memory the buffers hold now.
-    pub fn bytes(&self) -> u64 {
+    pub(crate) fn bytes(&self) -> u64 {
         let buffers = [
             &self.params,
             &self.status,

@@ -21,7 +21,7 @@ pub(super) const MAX_BATCH: usize = 64;
 /// `solve_joints` passes, one after each relaxation sweep (rounded up). A
 /// chain converges in a few; a bridge pinned taut at both ends and loaded
 /// is the slowest case met (docs/step.md, "Joints").
-pub const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
+pub(crate) const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 
 impl World {
     /// The Params slots a substep takes: its own, then one per colour of
@@ -174,6 +174,8 @@ impl World {
     /// the integration, its share of the `iterations` sweeps of the solve's
     /// two halves (`Settings::sweeps`) and the restitution's two (the
     /// contacts, kept in the bodies' own frames, serve all substeps).
+    // For the crate's own tests and the binary's bench, not part of the guide.
+    #[doc(hidden)]
     pub fn step_plan(&self) -> Vec<(Stage, usize)> {
         // a scan of one block is finished by its first pass (grid.wgsl)
         let many_blocks = |len: u32| len > SCAN_SPAN;
@@ -228,6 +230,7 @@ impl World {
     /// Runs `stages` alone, in order, each as a step's first substep runs it,
     /// and leaves the step count as it was: a way to check one kernel
     /// against a known answer (tests/gpu/kernels.rs), not a way to simulate.
+    // For the crate's own tests, not part of the guide.
     #[doc(hidden)]
     pub fn run_stages(&mut self, stages: &[Stage]) -> Result<(), Error> {
         (self.at_rest, self.skipped) = (false, false);

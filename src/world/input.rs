@@ -36,7 +36,7 @@ use crate::gpu::types::WORKGROUP;
 use crate::Error;
 
 /// `shaders/input.wgsl`, the kernels of this module.
-pub const INPUT: &str = include_str!("../../shaders/input.wgsl");
+pub(crate) const INPUT: &str = include_str!("../../shaders/input.wgsl");
 
 /// Entry points of the input module.
 pub const ENTRY_POINTS: [&str; 4] = ["apply_inputs", "explode", "wind", "wake_all"];
@@ -143,7 +143,7 @@ impl Wind {
     }
 
     /// The gust profile s(t), in [-1, 1].
-    pub fn gust_profile(&self, t: f64) -> f64 {
+    fn gust_profile(&self, t: f64) -> f64 {
         let phase = std::f64::consts::TAU * t / self.gust_period as f64;
         0.6 * phase.sin() + 0.4 * (2.71 * phase + 1.3).sin()
     }

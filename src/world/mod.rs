@@ -18,7 +18,7 @@ use crate::Error;
 
 mod buffers;
 mod capacity;
-pub mod edit;
+mod edit;
 mod encode;
 pub mod input;
 mod pools;
@@ -34,18 +34,12 @@ use pools::PoolWatch;
 pub use capacity::{
     body_bytes, bytes_per_body, manifold_bytes, max_bodies, pair_bytes, pair_capacities, MANIFOLDS_PER_BODY, PAIRS_PER_BODY,
 };
-pub use encode::JOINT_SWEEPS_PER_SUBSTEP;
 pub use pools::SHRINK_AFTER_STEPS;
 pub use profile::StageTimes;
 pub use readback::BodyOutput;
-pub use records::{
-    body_output, body_props, initial_state, joint_gaps, joint_lists, plan_grid, scene_props, GridLayout, JointLists,
-};
+pub use records::{initial_state, joint_gaps, plan_grid, GridLayout};
+pub(crate) use records::{joint_lists, scene_props};
 pub use status::ContactReport;
-// the limits' and faults' old home
-pub use crate::limits::{
-    Fault, FaultKind, CONTACT_MARGIN, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, MIN_SUBSTEP, NO_FAULT,
-};
 
 /// The host's side of where a batch of steps started (`World::batch_start`).
 #[derive(Clone, Copy)]
@@ -177,11 +171,15 @@ impl World {
     }
 
     /// The grid the broadphase uses.
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
     pub fn grid(&self) -> GridLayout {
         self.grid
     }
 
     /// The buffer holding the current poses (for drawing without readback).
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
     pub fn current_state_buffer(&self) -> &wgpu::Buffer {
         &self.data.states[self.current]
     }

@@ -16,8 +16,8 @@ pub struct BodyOutput {
     pub position: [f32; 3],
     /// Unit quaternion (x, y, z, w).
     pub orientation: [f32; 4],
-    /// Velocity at the step's time (m/s), from Verlet's displacement (see
-    /// [`body_output`]).
+    /// Velocity at the step's time (m/s), from Verlet's displacement over
+    /// the last substep: exact in free fall, 0 at rest.
     pub linear_velocity: [f32; 3],
     /// World frame (rad/s).
     pub angular_velocity: [f32; 3],
@@ -63,6 +63,8 @@ impl World {
     }
 
     /// Reads every body's GPU state back as it is stored.
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
     pub fn read_raw(&self) -> Result<Vec<BodyState>, Error> {
         let size = (self.body_count.max(1) as usize * size_of::<BodyState>()) as u64;
         let bytes = self.gpu.read_buffer(&self.data.states[self.current], size)?;
@@ -101,6 +103,7 @@ impl World {
     }
 
     /// One of the step's buffers, read back as 32-bit words (tests).
+    // For the crate's own tests, not part of the guide.
     #[doc(hidden)]
     pub fn read_words(&self, buffer: Buffer) -> Result<Vec<u32>, Error> {
         let b = self.data.buffer(buffer, self.current);

@@ -69,7 +69,7 @@ fn dquat(v: [f32; 4]) -> DQuat {
 /// joint is not known to, and resting on the ground it accelerates at none,
 /// so it reads `disp / dt`, which is 0 at rest. Angular velocity has no
 /// acceleration to correct (no torques): the last substep's turn over dt.
-pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> BodyOutput {
+pub(crate) fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> BodyOutput {
     let free = s.pos_low & HELD == 0 && !joined;
     let half_step = if free { DVec3::from_array(gravity.map(|g| g as f64)) * (0.5 * dt) } else { DVec3::ZERO };
     let disp = DVec3::new(s.disp[0] as f64, s.disp[1] as f64, s.disp[2] as f64);
@@ -118,7 +118,7 @@ pub fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> B
 ///   paths of one colour share a movable body, so `solve_joints` sweeps a
 ///   colour's paths side by side, one invocation each, and the colours one
 ///   after the other (Gauss-Seidel along a path and between colours).
-pub struct JointLists {
+pub(crate) struct JointLists {
     pub starts: Vec<u32>,
     pub refs: Vec<JointRef>,
     pub islands: u32,
@@ -130,7 +130,7 @@ pub struct JointLists {
 /// The most joints of one path: an invocation sweeps it forward and back,
 /// within the driver's loop limit with room to spare (`solve_joints`), and
 /// long enough that a chain or a row of a grid is one path.
-pub const PATH_JOINTS: usize = 128;
+pub(crate) const PATH_JOINTS: usize = 128;
 
 /// The joint closes a path cut from a large island makes in one
 /// `solve_joints` pass at most: min(joint_sweeps, this / 2n) sweeps of its
@@ -139,27 +139,22 @@ pub const PATH_JOINTS: usize = 128;
 /// colours' turns carry the rest: the grid of 100 x 100 opened 7.4 mm in 5
 /// s at the defaults, 7.5 with 3 sweeps a pass, 8.0 with 5 at 2.8 times
 /// the cost, 24 with one.
-pub const CUT_PATH_CLOSES: u32 = 512;
+pub(crate) const CUT_PATH_CLOSES: u32 = 512;
 
 impl JointLists {
     /// The most joints one island holds (0 without joints), of a scene of
     /// `bodies` bodies.
-    pub fn largest_island(&self, bodies: usize) -> u32 {
+    pub(crate) fn largest_island(&self, bodies: usize) -> u32 {
         self.starts[bodies + 1..bodies + 2 + self.islands as usize].windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0)
     }
 
-    /// The paths `solve_joints` sweeps.
-    pub fn path_count(&self) -> u32 {
-        self.colours.last().copied().unwrap_or(0)
-    }
-
     /// The paths' colours: `solve_joints` is dispatched once per colour.
-    pub fn colour_count(&self) -> u32 {
+    pub(crate) fn colour_count(&self) -> u32 {
         self.colours.len().saturating_sub(1) as u32
     }
 }
 
-pub fn joint_lists(scene: &Scene) -> JointLists {
+pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
     let n = scene.bodies.len();
     let movable = |b: i32| b >= 0 && !scene.bodies[b as usize].fixed;
     let mut per_body: Vec<Vec<JointRef>> = vec![Vec::new(); n];
@@ -390,7 +385,7 @@ pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
 
 /// Every body's GPU record, the bodies kept out of the grid (`LARGE_BODY` in
 /// their records) and the grid for the rest.
-pub fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
+pub(crate) fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
     let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &scene.settings)).collect();
     for (p, limit) in props.iter_mut().zip(speed_limits(scene)) {
         p.speed_limit = limit;
@@ -414,7 +409,7 @@ pub fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
 /// the integration's own error room. With gravity but no ground under it
 /// (none, or gravity not straight down) a fall has no bound, and no body
 /// gets a limit; fixed bodies need none.
-pub fn speed_limits(scene: &Scene) -> Vec<f32> {
+pub(crate) fn speed_limits(scene: &Scene) -> Vec<f32> {
     let g = DVec3::from_array(scene.settings.gravity.map(|v| v as f64));
     let ground = match &scene.ground {
         Some(ground) if g.x == 0.0 && g.z == 0.0 && g.y <= 0.0 => Some(ground.height as f64),
@@ -435,7 +430,7 @@ pub fn speed_limits(scene: &Scene) -> Vec<f32> {
 }
 
 /// The GPU record of a body's shape, mass and material.
-pub fn body_props(b: &Body, settings: &Settings) -> BodyProps {
+pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
     let (half, shape) = match b.shape {
         Shape::Box { half_extents: h } => ([h[0], h[1], h[2]], SHAPE_BOX),
         Shape::Sphere { radius } => ([radius, radius, radius], SHAPE_SPHERE),
@@ -457,7 +452,7 @@ pub fn body_props(b: &Body, settings: &Settings) -> BodyProps {
 /// that the first Verlet step reproduces the initial velocities exactly:
 /// disp = x0 - x_prev = v0 h - g h^2/2 makes x1 = x0 + v0 h + g h^2/2, and
 /// Verlet then stays on the parabola. A fixed body is `HELD` (see
-/// [`body_output`]); no rounding remainder yet (x0 is exact).
+/// `body_output`); no rounding remainder yet (x0 is exact).
 pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
     let x0 = DVec3::from_array(b.position.map(|v| v as f64));
     let o = b.orientation;
@@ -572,7 +567,7 @@ mod tests {
             let lists = joint_lists(&scene);
             let n = scene.bodies.len();
             let first = n + 2 + lists.islands as usize;
-            let count = lists.path_count() as usize;
+            let count = lists.colours.last().copied().unwrap_or(0) as usize;
             let paths: Vec<&[JointRef]> =
                 lists.starts[first..first + count + 1].windows(2).map(|w| &lists.refs[w[0] as usize..w[1] as usize]).collect();
             let moving = |b: u32| b != WORLD && !scene.bodies[b as usize].fixed;

@@ -107,12 +107,16 @@ impl Snapshot {
     }
 
     /// The poses, as `World::read_raw` gives them.
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
     pub fn states(&self) -> &[BodyState] {
         &self.states
     }
 
     /// Every body's wake flags: not 0 for a sleeper woken in the last step,
     /// which wakes in the next.
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
     pub fn woken(&self) -> &[u8] {
         &self.woken
     }

@@ -63,6 +63,7 @@ impl World {
 
     /// The status record as the GPU left it (a blocking readback, for tests
     /// and debugging).
+    // For the crate's own tests, not part of the guide.
     #[doc(hidden)]
     pub fn read_status(&self) -> Result<Status, Error> {
         let bytes = self.gpu.read_buffer(&self.data.status, Status::BYTES)?;

@@ -244,7 +244,7 @@ fn unusable_output_paths_are_refused_before_the_first_step() {
 
 /// A scene whose run fails a few steps in: body 1 of a row, placed 999 km
 /// out and flying outward at 9 km/s (each within what a scene may ask),
-/// passes 1000 km (`world::MAX_DISTANCE`) at about step 6, and the
+/// passes 1000 km (`limits::MAX_DISTANCE`) at about step 6, and the
 /// numerical fault stops the run.
 fn flying_scene() -> String {
     let mut scene = scenes::stack(0);
@@ -584,7 +584,7 @@ fn a_blob_thrown_by_the_solver_fails_the_run() {
 
 #[test]
 fn a_body_turning_more_than_a_substep_holds_is_faulted() {
-    use verlet::world::{Fault, FaultKind};
+    use verlet::{Fault, FaultKind};
     let mut scene = scenes::stack(0);
     scene.settings.gravity = [0.0; 3];
     scene.bodies = (0..3).map(|k| scenes::box_body([0.5; 3], [10.0 * k as f32, 5.0, 0.0])).collect();

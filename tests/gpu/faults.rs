@@ -7,8 +7,8 @@
 use std::process::Command;
 
 use verlet::gpu::types::BodyState;
-use verlet::world::{Fault, FaultKind};
 use verlet::{scenes, Error, Scene, World};
+use verlet::{Fault, FaultKind};
 
 /// Five unit boxes on the ground, 10 m apart: they never touch.
 fn row() -> Scene {
@@ -74,7 +74,7 @@ fn a_step_too_short_for_the_poses_is_refused_and_the_shortest_rests() {
     assert!(matches!(&err, Error::Input(m) if m.starts_with("dt[1]: ") && m.contains("shorter than 1e-5 s")), "{err}");
     assert_eq!(world.step_count(), 30, "nothing taken");
     assert_eq!(raw(&world), before, "the poses as they were");
-    let shortest = verlet::world::MIN_SUBSTEP * world.settings().substeps as f32;
+    let shortest = verlet::limits::MIN_SUBSTEP * world.settings().substeps as f32;
     world.step_with(&[shortest; 50]).unwrap();
     assert_eq!(world.faults().unwrap(), None);
     assert_eq!(world.step_count(), 80);

@@ -177,7 +177,7 @@ fn assert_cell_bounds(w: &verlet::World, n: usize) -> Vec<u32> {
         want.extend((0..3).map(|c| word(i, std::mem::offset_of!(PairMeta, extent) + 4 * c)));
         // FAST_BODY: a grown box larger than grid.wgsl's fast_size (not a sleeper)
         let extent = (0..3).map(|c| f32::from_bits(word(i, std::mem::offset_of!(PairMeta, extent) + 4 * c)));
-        let fast_size = 0.5 * (0.999 * w.grid().cell_size - verlet::world::CONTACT_MARGIN);
+        let fast_size = 0.5 * (0.999 * w.grid().cell_size - verlet::limits::CONTACT_MARGIN);
         let fast = if extent.fold(0.0, f32::max) > fast_size && moves != SLEEPS { FAST_BODY } else { 0 };
         want.push(i as u32 | fast | moves << MOVES_SHIFT);
         assert_eq!(&bounds[record * k..record * (k + 1)], &want[..], "cell_bounds[{k}] (body {i})");
@@ -329,7 +329,7 @@ fn the_pair_list_holds_every_pair_within_reach_once_at_any_speed() {
     let states = w.read_raw().unwrap();
     let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
     let cell = w.grid().cell_size;
-    let margin = verlet::world::CONTACT_MARGIN;
+    let margin = verlet::limits::CONTACT_MARGIN;
     // how far the pair is from wanted_bounds's limits (pairs.wgsl): > 0
     // wanted, < 0 not; within a rounding of 0 either may be
     let inside = |i: usize, j: usize| -> f32 {
@@ -427,7 +427,7 @@ fn ball_over_a_floor(side: usize) -> Option<(verlet::World, verlet::world::Conta
         words.chunks(2).take(report.pairs as usize).filter(|p| p.contains(&(n as u32 - 1))).map(|p| p[0].min(p[1])).collect();
     let states = w.read_raw().unwrap();
     let meta: Vec<PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
-    let margin = verlet::world::CONTACT_MARGIN;
+    let margin = verlet::limits::CONTACT_MARGIN;
     let ball = &meta[n - 1];
     let wanted: Vec<u32> = (0..n - 1)
         .filter(|&j| {

@@ -5,9 +5,10 @@
 use crate::common::world;
 use crate::common::Rng;
 use glam::{Quat, Vec3};
+use verlet::limits::CONTACT_MARGIN;
 use verlet::reference::collide::{collide, Placed, ShapeKind};
 use verlet::scenes::{box_body, sphere_body};
-use verlet::world::{initial_state, CONTACT_MARGIN};
+use verlet::world::initial_state;
 use verlet::{Body, Scene, Settings, Shape};
 
 fn random_body(rng: &mut Rng, k: usize, at: Vec3) -> Body {

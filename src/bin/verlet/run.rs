@@ -300,7 +300,7 @@ fn step_and_record(
 /// the one before (where the state may have gone bad), named for the
 /// fault's message: an impulse of 1e30 N s is the input's doing, not the
 /// solver's.
-fn inputs_before(track: Option<&Track>, fault: &verlet::world::Fault, world: &World) -> String {
+fn inputs_before(track: Option<&Track>, fault: &verlet::Fault, world: &World) -> String {
     let Some(track) = track else { return String::new() };
     let acting = track.acting_before(fault.step.saturating_sub(1)..=fault.step, world.settings().dt);
     if acting.is_empty() {
