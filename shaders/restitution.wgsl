@@ -1,13 +1,13 @@
-// Passes "restitution_contacts", once per substep after the solve, and
-// "restitution", after the step's last substep: collisions change velocity by
+// Passes "restitution_contacts" and "restitution", once a step after its last
+// substep (as Box2D's and Box3D's restitution): collisions change velocity by
 // rewriting the previous pose (the paper, section III; here disp and
-// prev_rot). A contact that approached faster than both RESTITUTION_THRESHOLD
-// and what a resting contact can reach (2 |g| dt) leaves at -e times its
-// approach speed; slower ones stay at rest, so resting bodies do not hop.
-// Dynamic friction takes up to mu times the push's normal impulse from a
+// prev_rot). A contact that approached, as the step began, faster than both
+// RESTITUTION_THRESHOLD and what a resting contact can reach (2 |g| h) leaves
+// at -e times that speed; slower ones stay at rest, so resting bodies do not
+// hop. Dynamic friction takes up to mu times the step's normal impulse from a
 // contact still sliding. As in the solve, restitution_contacts measures each
-// manifold once (two EndSnaps; it empties the friction budgets) and
-// `restituted` sums a body's in pair order. See docs/decisions/restitution.md.
+// manifold once (two EndSnaps) and `restituted` sums a body's in pair order.
+// See docs/decisions/restitution.md.
 
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
@@ -34,8 +34,8 @@ fn end_velocity(i: u32, e: ContactEnd) -> Velocity {
     return pose_velocity(e.disp, e.rot, e.prev_rot);
 }
 
-// ... and before it (integrate's vel0): zero for an end the contacts may not move,
-// as integrate writes for a fixed body or a sleeper (an unlisted one is not integrated).
+// ... and as the step began (contact_lists' vel0): zero for an end the contacts
+// may not move.
 fn end_velocity_before(i: u32, e: ContactEnd) -> Velocity {
     if (!e.moves) {
         return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
@@ -60,9 +60,6 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     let count = m.count;
     let at = point_slot(k);
     if (!ea.moves && !eb.moves) {
-        for (var q = 0u; q < count; q = q + 1u) {
-            set_pushed(at, q, 0.0);
-        }
         return;
     }
     let va0 = end_velocity_before(a, ea);
@@ -92,7 +89,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     var acting = 0u;
     for (var q = 0u; q < count; q = q + 1u) {
         let pt = point_of(at, q);
-        set_pushed(at, q, 0.0);
+        // the normal push over the whole step
+        let pushed = pt.pushed + pt.pushed_before;
         let ra = ea.rot_m * end_point(ea, pt.local_a, n);
         let rb = eb.rot_m * end_point(eb, pt.local_b, -n);
         // touching?
@@ -108,14 +106,14 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         // dynamic friction against the sliding left after the solve
         let v_t = relative_now - n * dot(relative_now, n);
         let sliding = length(v_t);
-        if (pt.pushed > 0.0 && sliding > 1e-6) {
+        if (pushed > 0.0 && sliding > 1e-6) {
             let t = v_t / sliding;
             // Coulomb's bound is on the impulse: mu times the normal one (the
             // push through the inverse mass along n); bounding the velocity
             // change instead gave a sliding ball 3.5 times too little friction
             let w_t = end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t);
             let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
-            let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / (split * w_t));
+            let j = min(mu * pushed / params.dt / max(w_n, 1e-30), sliding / (split * w_t));
             impulse = impulse + t * j;
             acted = true;
         }
@@ -158,14 +156,12 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
 }
 
 // The body half: body i's state with what its manifolds ask applied (summed in
-// pair order), or s_in itself for a body fixed, asleep or touching nothing, or
-// where nothing is `pending`. The pass `restitution` applies it after the last
-// substep, integrate before every later one; `pending` enters by a select.
-fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState {
+// pair order), or s_in itself for a body fixed, asleep or touching nothing.
+fn restituted(i: u32, s_in: BodyState, p: BodyProps) -> BodyState {
     var s = s_in;
     let first = pair_meta[i].list_start;
     let acts = moves_by_contacts(s, p);
-    let end = select(first, first + pair_meta[i].contacts, acts && pending);
+    let end = select(first, first + pair_meta[i].contacts, acts);
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
@@ -205,5 +201,5 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    set_state(i, restituted(i, state_of(i), props_of(i), true));
+    set_state(i, restituted(i, state_of(i), props_of(i)));
 }

@@ -50,8 +50,22 @@ fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
     return splits;
 }
 
+// Pass "solve_contacts_first", a substep's first sweep: as solve_contacts,
+// with the points' static-friction budgets started afresh (the last
+// substep's pushes added to `pushed_before`, dynamic friction's budget).
+@compute @workgroup_size(WORKGROUP)
+fn solve_contacts_first(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    relax_contacts(gid, groups, true);
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    relax_contacts(gid, groups, false);
+}
+
+// One manifold's snaps; `first`, a constant where it is called, in a
+// substep's first sweep.
+fn relax_contacts(gid: vec3<u32>, groups: vec3<u32>, first: bool) {
     let used = manifolds_used();
     let nth = dispatch_index(gid, groups);
     if (nth >= used) {
@@ -98,7 +112,11 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     var shallow_depth = 0.0;
     var all_depth = 0.0;
     for (var q = 0u; q < count; q = q + 1u) {
-        let pt = point_of(at, q);
+        var pt = point_of(at, q);
+        if (first) {
+            set_pushed_before(at, q, pt.pushed_before + pt.pushed);
+            pt.pushed = 0.0;
+        }
         let local_a = end_point(ea, pt.local_a, n);
         let local_b = end_point(eb, pt.local_b, -n);
         let ra = ea.rot_m * local_a;
