@@ -227,22 +227,12 @@ fn set_pushed(at: vec2<u32>, q: u32, pushed: f32) {
     }
 }
 
-// Sets point q's push over the step's earlier substeps (`pushed_before`).
-fn set_pushed_before(at: vec2<u32>, q: u32, pushed: f32) {
-    switch (at.x) {
-        case 0u: { points[at.y].at[2u * q + 1u].w = pushed; }
-        case 1u: { points_1[at.y].at[2u * q + 1u].w = pushed; }
-        case 2u: { points_2[at.y].at[2u * q + 1u].w = pushed; }
-        default: { points_3[at.y].at[2u * q + 1u].w = pushed; }
-    }
-}
-
 fn store_points(k: u32, p: ManifoldPoints) {
     let at = point_slot(k);
     var w: PointsWords;
     for (var q = 0u; q < MAX_POINTS; q = q + 1u) {
         w.at[2u * q] = vec4<f32>(p.at[q].local_a, p.at[q].pushed);
-        w.at[2u * q + 1u] = vec4<f32>(p.at[q].local_b, p.at[q].pushed_before);
+        w.at[2u * q + 1u] = vec4<f32>(p.at[q].local_b, p.at[q]._pad0);
     }
     switch (at.x) {
         case 0u: { points[at.y] = w; }

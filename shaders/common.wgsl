@@ -99,14 +99,12 @@ struct Pair {
 }
 
 // One contact point: the point on each body in its own frame (the ground's in world
-// coordinates), and its friction budgets: the normal push summed this substep (static
-// friction's, in the solve) and over the step's earlier substeps (dynamic friction's,
-// with `pushed`, in the restitution at the step's end) (m). 32 bytes.
+// coordinates), and its friction budget: the normal push summed this substep (m). 32 bytes.
 struct ContactPoint {
     local_a: vec3<f32>,
     pushed: f32,
     local_b: vec3<f32>,
-    pushed_before: f32,
+    _pad0: f32,
 }
 
 // A pair's contact manifold, found once a step: up to MAX_POINTS points sharing one

@@ -149,9 +149,7 @@ pub struct ContactPoint {
     pub pushed: f32,
     /// On body b, in its frame (the ground's: world coordinates).
     pub local_b: [f32; 3],
-    /// The normal push summed over the step's earlier substeps (m): with
-    /// `pushed`, dynamic friction's budget at the step's end.
-    pub pushed_before: f32,
+    pub _pad0: f32,
 }
 
 /// A pair's manifold's header (32 bytes): up to `MAX_POINTS` points sharing

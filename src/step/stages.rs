@@ -306,7 +306,7 @@ pub const TABLE: [StageInfo; 22] = {
         S {
             over: Over::Manifolds,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            reads: &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, Points, Points1, Points2, Points3],
             writes: &[Snaps, Snaps1],
             ..S::row(Stage::RestitutionContacts, "restitution_contacts", RESTITUTION_PASS, Part::Restitution)
         },

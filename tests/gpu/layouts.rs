@@ -78,7 +78,7 @@ fn shared_structs_match_member_by_member() {
     check_layout!(common, JointRef { local_self, partner, local_partner, body });
     check_layout!(common, Pair { a, b });
     check_layout!(common, CellBound { pos, bound, extent, body });
-    check_layout!(common, ContactPoint { local_a, pushed, local_b, pushed_before });
+    check_layout!(common, ContactPoint { local_a, pushed, local_b, _pad0 });
     check_layout!(common, ContactManifold { normal, count, a, b, clip_face, pair });
     check_layout!(common, ManifoldPoints { at });
     check_layout!(common, EndSnap { dx, count, dtheta, flags });
