@@ -4,9 +4,9 @@
 // prev_rot). A contact that approached, as the step began, faster than both
 // RESTITUTION_THRESHOLD and what a resting contact can reach (2 |g| h) leaves
 // at -e times that speed; slower ones stay at rest, so resting bodies do not
-// hop. Dynamic friction acts in the solve. As in the solve, restitution_contacts
-// measures each manifold once (two EndSnaps) and `restituted` sums a body's in
-// pair order. See docs/decisions/restitution.md.
+// hop (dynamic friction acts in the solve). As in the solve, restitution_contacts measures each
+// manifold once (two EndSnaps) and `restituted` sums a body's in pair order.
+// See docs/decisions/restitution.md.
 
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;

@@ -15,7 +15,7 @@ struct Snap {
 
 // Each point's normal snap closes its depth, shared by the inverse masses;
 // friction (XPBD) undoes a slide shorter than mu times the summed push, and takes
-// mu times the sweep's normal impulse from a longer one (Coulomb, per sweep).
+// mu times its push from a longer one (dynamic friction, Coulomb per sweep).
 // The points of one face each ask the whole depth, so their sum is scaled down
 // to what moving the bodies apart without turning asks, and their turns averaged.
 
