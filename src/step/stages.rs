@@ -165,15 +165,6 @@ pub(crate) const TABLE: [StageInfo; 22] = {
     const POOL_WRITES: &[Buffer] = &[Manifolds, Status, PairMeta, BodyPairs, Points, Points1, Points2, Points3];
     const SNAP_WRITES: &[Buffer] = &[Snaps, Points, Points1, Points2, Points3, Snaps1];
     const JOINT_READS: &[Buffer] = &[Params, Props, StateOut, JointStart, JointRefs];
-    const fn solve_contacts_row(stage: Stage, name: &'static str) -> StageInfo {
-        S {
-            over: Over::Manifolds,
-            runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
-            writes: SNAP_WRITES,
-            ..S::row(stage, name, SOLVE_PASS, Part::Solve)
-        }
-    }
     let table = [
         S {
             reads: &[Params, Props, StateIn, CellCount, Status],
@@ -274,9 +265,20 @@ pub(crate) const TABLE: [StageInfo; 22] = {
             writes: &[StateOut, Status, PairMeta],
             ..S::row(Stage::Integrate, "integrate", INTEGRATE_PASS, Part::Integrate)
         },
-        // a substep's first sweep, then the others: the same kernel
-        solve_contacts_row(Stage::SolveContactsFirst, "solve_contacts_first"),
-        solve_contacts_row(Stage::SolveContacts, "solve_contacts"),
+        S {
+            over: Over::Manifolds,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            writes: SNAP_WRITES,
+            ..S::row(Stage::SolveContactsFirst, "solve_contacts_first", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::Manifolds,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            writes: SNAP_WRITES,
+            ..S::row(Stage::SolveContacts, "solve_contacts", SOLVE_PASS, Part::Solve)
+        },
         S {
             over: Over::Listed,
             poses: Poses::Flip,
