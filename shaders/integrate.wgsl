@@ -1,6 +1,8 @@
 // Pass "integrate": the paper's position Verlet, eqs. 6 and 7, time-corrected
 // for a changing dt (eq. 11) and damped (eq. 12). Reads state_in, writes each
-// body's own slot of state_out (the predicted pose).
+// body's own slot of state_out (the predicted pose) and of vel0. After a
+// step's first substep it first applies the last substep's restitution
+// (restitution.wgsl's `restituted`): a dispatch and a state copy fewer.
 //
 // Numerical faults: every substep, with no readback, a body whose pose is not
 // finite, lies beyond MAX_DISTANCE, or moved or turned faster than MAX_SPEED,
@@ -106,7 +108,8 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let p = props_of(i);
-    let s = state_of(i);
+    // the last substep's restitution first (none before a step's first substep)
+    let s = restituted(i, state_of(i), p, params.substep != 0u);
     let dt = params.dt;
     let wake = params.substep == 0u && (s.pos_low & WAKES) != 0u;
     let wakes = wakes_next(i, s);
@@ -131,11 +134,13 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
             q = normalize(s.prev_rot);
         }
         set_state(i, BodyState(at, 0.0, vec3<f32>(0.0), 0u, q, q));
+        vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         moved();
         return;
     }
     if (is_fixed(p)) {
         set_state(i, BodyState(s.pos, s.rest_time, vec3<f32>(0.0), HELD, s.rot, s.rot));
+        vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         return;
     }
     // seconds at rest, this substep included (asleep() is false with sleeping off)
@@ -154,6 +159,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (rest >= params.sleep_after && rest > 0.0) {
         // asleep: held still where it is (resting on what pressed it)
         set_state(i, BodyState(s.pos, rest, vec3<f32>(0.0), (s.pos_low & ~WAKES) | HELD | wakes, s.rot, s.rot));
+        vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
         if (wakes != 0u) {
             moved();
         }
@@ -183,5 +189,6 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let spin = quat_to_rotvec(turn);
 
     set_state(i, BodyState(pos, rest, disp, pack_remainder(dropped, pos, (s.pos_low & HELD) | wakes), rot, s.rot));
+    vel0[i] = Velocity(vec4<f32>(disp / dt, 0.0), vec4<f32>(spin / dt, 0.0));
     moved();
 }

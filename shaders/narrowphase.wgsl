@@ -265,11 +265,6 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    // the body's velocity as the step begins: the restitution at its end
-    // measures approach speeds by it
-    let s = state_of(i);
-    let spin = quat_to_rotvec(quat_mul(s.rot, quat_conj(s.prev_rot)));
-    vel0[i] = Velocity(vec4<f32>(s.disp / params.dt_prev, 0.0), vec4<f32>(spin / params.dt_prev, 0.0));
     let first = pair_meta[i].list_start;
     let end = min(first + atomicLoad(&pair_meta[i].cursor), arrayLength(&body_pairs));
     list_trips = 0u;

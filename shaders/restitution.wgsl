@@ -1,12 +1,13 @@
-// Passes "restitution_contacts" and "restitution", once a step after its last
-// substep (as Box2D's and Box3D's restitution): collisions change velocity by
+// Passes "restitution_contacts", once per substep after the solve, and
+// "restitution", after the step's last substep: collisions change velocity by
 // rewriting the previous pose (the paper, section III; here disp and
-// prev_rot). A contact that approached, as the step began, faster than both
-// RESTITUTION_THRESHOLD and what a resting contact can reach (2 |g| h) leaves
-// at -e times that speed; slower ones stay at rest, so resting bodies do not
-// hop (dynamic friction acts in the solve). As in the solve, restitution_contacts measures each
-// manifold once (two EndSnaps) and `restituted` sums a body's in pair order.
-// See docs/decisions/restitution.md.
+// prev_rot). A contact that approached faster than both RESTITUTION_THRESHOLD
+// and what a resting contact can reach (2 |g| dt) leaves at -e times its
+// approach speed; slower ones stay at rest, so resting bodies do not hop.
+// Dynamic friction takes up to mu times the push's normal impulse from a
+// contact still sliding. As in the solve, restitution_contacts measures each
+// manifold once (two EndSnaps; it empties the friction budgets) and
+// `restituted` sums a body's in pair order. See docs/decisions/restitution.md.
 
 // Approach speeds (m/s) below this never bounce; Box2D's default too.
 const RESTITUTION_THRESHOLD: f32 = 1.0;
@@ -33,8 +34,8 @@ fn end_velocity(i: u32, e: ContactEnd) -> Velocity {
     return pose_velocity(e.disp, e.rot, e.prev_rot);
 }
 
-// ... and as the step began (contact_lists' vel0): zero for an end the contacts
-// may not move.
+// ... and before it (integrate's vel0): zero for an end the contacts may not move,
+// as integrate writes for a fixed body or a sleeper (an unlisted one is not integrated).
 fn end_velocity_before(i: u32, e: ContactEnd) -> Velocity {
     if (!e.moves) {
         return Velocity(vec4<f32>(0.0), vec4<f32>(0.0));
@@ -59,6 +60,9 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     let count = m.count;
     let at = point_slot(k);
     if (!ea.moves && !eb.moves) {
+        for (var q = 0u; q < count; q = q + 1u) {
+            set_pushed(at, q, 0.0);
+        }
         return;
     }
     let va0 = end_velocity_before(a, ea);
@@ -66,9 +70,21 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     let va = end_velocity(a, ea);
     let vb = end_velocity(b, eb);
     let threshold = max(2.0 * length(params.gravity) * params.dt, RESTITUTION_THRESHOLD);
+    let mu = combined_friction(ea, eb);
     let e = combined_restitution(ea, eb);
-    // summed over the points: the bounce asked of b (a gets the opposite; times
-    // the inverse masses later), its moments, the points' 1 / w
+    // against an end that stays, each contact cuts at most its share of the
+    // sliding (friction_split; read only then, and never both ends stay here)
+    var split = 1.0;
+    if (!eb.moves) {
+        split = friction_split(a, 1.0);
+    } else if (!ea.moves) {
+        split = friction_split(b, 1.0);
+    }
+    // summed over the points: the velocity change asked of b (a gets the opposite;
+    // times the inverse masses later), its moments; the bounces apart, with their 1 / w
+    var j = vec3<f32>(0.0);
+    var moment_a = vec3<f32>(0.0);
+    var moment_b = vec3<f32>(0.0);
     var bounce_j = vec3<f32>(0.0);
     var bounce_moment_a = vec3<f32>(0.0);
     var bounce_moment_b = vec3<f32>(0.0);
@@ -76,22 +92,46 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     var acting = 0u;
     for (var q = 0u; q < count; q = q + 1u) {
         let pt = point_of(at, q);
+        set_pushed(at, q, 0.0);
         let ra = ea.rot_m * end_point(ea, pt.local_a, n);
         let rb = eb.rot_m * end_point(eb, pt.local_b, -n);
         // touching?
         if (dot((eb.pos + rb) - (ea.pos + ra), n) > CONTACT_SLOP) {
             continue;
         }
-        // a's point's velocity relative to b's after the solve; the approach as the step began
+        // a's point's velocity relative to b's after the solve; the approach before it
         let relative_now = point_velocity(va, ra) - point_velocity(vb, rb);
         let approach = -dot(point_velocity(va0, ra) - point_velocity(vb0, rb), n);
+        var impulse = vec3<f32>(0.0);
+        var bounce = vec3<f32>(0.0);
+        var acted = false;
+        // dynamic friction against the sliding left after the solve
+        let v_t = relative_now - n * dot(relative_now, n);
+        let sliding = length(v_t);
+        if (pt.pushed > 0.0 && sliding > 1e-6) {
+            let t = v_t / sliding;
+            // Coulomb's bound is on the impulse: mu times the normal one (the
+            // push through the inverse mass along n); bounding the velocity
+            // change instead gave a sliding ball 3.5 times too little friction
+            let w_t = end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t);
+            let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
+            let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / (split * w_t));
+            impulse = impulse + t * j;
+            acted = true;
+        }
         // restitution of a fast approach (approach < 0: closing), along a's push -n
         let vn = -dot(relative_now, n);
         let target_vn = -e * approach;
         if (approach < -threshold && vn < target_vn) {
             let w = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
-            let bounce = n * ((target_vn - vn) / w);
+            bounce = n * ((target_vn - vn) / w);
             bounce_inv_w = bounce_inv_w + 1.0 / w;
+            acted = true;
+        }
+        if (acted) {
+            j = j + impulse;
+            moment_a = moment_a + cross(ra, impulse);
+            moment_b = moment_b + cross(rb, impulse);
             bounce_j = bounce_j + bounce;
             bounce_moment_a = bounce_moment_a + cross(ra, bounce);
             bounce_moment_b = bounce_moment_b + cross(rb, bounce);
@@ -109,21 +149,23 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         pair_w = pair_w + eb.inv_inertia.w;
     }
     let bounce_scale = min(1.0, 1.0 / max(pair_w * bounce_inv_w, 1e-30));
-    let j = bounce_j * bounce_scale;
-    let moment_a = bounce_moment_a * bounce_scale;
-    let moment_b = bounce_moment_b * bounce_scale;
+    j = j + bounce_j * bounce_scale;
+    moment_a = moment_a + bounce_moment_a * bounce_scale;
+    moment_b = moment_b + bounce_moment_b * bounce_scale;
     let flags = select(0u, SNAP_BOUNCE, bounce_inv_w > 0.0);
     set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a, acting, flags));
     set_snap(contact_ref(k, true), end_snap(eb, j, moment_b, acting, flags));
 }
 
 // The body half: body i's state with what its manifolds ask applied (summed in
-// pair order), or s_in itself for a body fixed, asleep or touching nothing.
-fn restituted(i: u32, s_in: BodyState, p: BodyProps) -> BodyState {
+// pair order), or s_in itself for a body fixed, asleep or touching nothing, or
+// where nothing is `pending`. The pass `restitution` applies it after the last
+// substep, integrate before every later one; `pending` enters by a select.
+fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState {
     var s = s_in;
     let first = pair_meta[i].list_start;
     let acts = moves_by_contacts(s, p);
-    let end = select(first, first + pair_meta[i].contacts, acts);
+    let end = select(first, first + pair_meta[i].contacts, acts && pending);
     var dv = vec3<f32>(0.0);
     var dw = vec3<f32>(0.0);
     var acting = 0u;
@@ -163,5 +205,5 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    set_state(i, restituted(i, state_of(i), props_of(i)));
+    set_state(i, restituted(i, state_of(i), props_of(i), true));
 }

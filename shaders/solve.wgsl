@@ -14,8 +14,7 @@ struct Snap {
 }
 
 // Each point's normal snap closes its depth, shared by the inverse masses;
-// friction (XPBD) undoes a slide shorter than mu times the summed push, and takes
-// mu times its push from a longer one (dynamic friction, Coulomb per sweep).
+// static friction (XPBD) undoes a slide shorter than mu times the summed push.
 // The points of one face each ask the whole depth, so their sum is scaled down
 // to what moving the bodies apart without turning asks, and their turns averaged.
 
@@ -51,21 +50,8 @@ fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
     return splits;
 }
 
-// Pass "solve_contacts_first", a substep's first sweep: as solve_contacts,
-// with the points' friction budgets started afresh.
-@compute @workgroup_size(WORKGROUP)
-fn solve_contacts_first(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    relax_contacts(gid, groups, true);
-}
-
 @compute @workgroup_size(WORKGROUP)
 fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    relax_contacts(gid, groups, false);
-}
-
-// One manifold's snaps; `first`, a constant where it is called, in a
-// substep's first sweep.
-fn relax_contacts(gid: vec3<u32>, groups: vec3<u32>, first: bool) {
     let used = manifolds_used();
     let nth = dispatch_index(gid, groups);
     if (nth >= used) {
@@ -112,10 +98,7 @@ fn relax_contacts(gid: vec3<u32>, groups: vec3<u32>, first: bool) {
     var shallow_depth = 0.0;
     var all_depth = 0.0;
     for (var q = 0u; q < count; q = q + 1u) {
-        var pt = point_of(at, q);
-        if (first) {
-            pt.pushed = 0.0;
-        }
+        let pt = point_of(at, q);
         let local_a = end_point(ea, pt.local_a, n);
         let local_b = end_point(eb, pt.local_b, -n);
         let ra = ea.rot_m * local_a;
@@ -142,11 +125,9 @@ fn relax_contacts(gid: vec3<u32>, groups: vec3<u32>, first: bool) {
         // still touches, so later sweeps' sideways pushes are resisted too
         var push = 0.0;
         var snapped = false;
-        var normal = 0.0; // the point's normal impulse (times the mass: m)
         if (depth > 0.0) {
             let w = end_inv_mass(ea, ra, n) * split_a.y + end_inv_mass(eb, rb, n) * split_b.y;
-            normal = depth / w;
-            let j = n * normal; // pushes b along n, a along -n
+            let j = n * (depth / w); // pushes b along n, a along -n
             normal_j = normal_j + j;
             moment_a = moment_a + cross(ra, j);
             moment_b = moment_b + cross(rb, j);
@@ -159,15 +140,10 @@ fn relax_contacts(gid: vec3<u32>, groups: vec3<u32>, first: bool) {
             let slip = moved_a - moved_b;
             let slip_t = slip - n * dot(slip, n);
             let slide = length(slip_t);
-            // static friction undoes a slide within mu times the substep's
-            // push; a longer one takes mu times this sweep's normal impulse
-            // (Coulomb's bound is on the impulse: a ball's point moves 3.5
-            // times as far along the ground as along the normal for one)
-            let t = slip_t / max(slide, 1e-30);
-            let w = end_inv_mass(ea, ra, t) * split_a.x + end_inv_mass(eb, rb, t) * split_b.x;
-            let tangent = select(mu * normal, slide / w, slide <= mu * (pt.pushed + push));
-            if (slide > 1e-9 && tangent > 0.0) {
-                let j = t * tangent; // pulls b along t, a back along -t
+            if (slide > 1e-9 && slide <= mu * (pt.pushed + push)) {
+                let t = slip_t / slide;
+                let w = end_inv_mass(ea, ra, t) * split_a.x + end_inv_mass(eb, rb, t) * split_b.x;
+                let j = t * (slide / w); // pulls b along t, a back along -t
                 friction_j = friction_j + j;
                 moment_a = moment_a + cross(ra, j);
                 moment_b = moment_b + cross(rb, j);

@@ -24,7 +24,6 @@ pub enum Stage {
     ContactLists,
     NarrowphaseClip,
     Integrate,
-    SolveContactsFirst,
     SolveContacts,
     Solve,
     JointRest,
@@ -152,7 +151,7 @@ impl StageInfo {
 }
 
 /// Every stage, in the order of `Stage` (checked as the table is built).
-pub(crate) const TABLE: [StageInfo; 22] = {
+pub(crate) const TABLE: [StageInfo; 21] = {
     use shaders::{GRID_PASS, INTEGRATE_PASS, NARROWPHASE_PASS, PAIRS_PASS, RESTITUTION_PASS, SOLVE_PASS};
     use Buffer::*;
     use Part::{Broadphase, Narrowphase};
@@ -246,7 +245,7 @@ pub(crate) const TABLE: [StageInfo; 22] = {
         },
         S {
             reads: &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
-            writes: &[Vel0, Sorted, Status, PairMeta, BodyPairs],
+            writes: &[Sorted, Status, PairMeta, BodyPairs],
             // once, for every contact and body pass of the step's substeps
             copy_after: &[Over::Manifolds, Over::Listed],
             ..S::row(Stage::ContactLists, "contact_lists", NARROWPHASE_PASS, Narrowphase)
@@ -261,16 +260,9 @@ pub(crate) const TABLE: [StageInfo; 22] = {
             over: Over::Listed,
             poses: Poses::Flip,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta],
-            writes: &[StateOut, Status, PairMeta],
+            reads: &[Params, Props, StateIn, Sorted, Status, JointStart, PairMeta, Snaps, BodyPairs, Snaps1],
+            writes: &[StateOut, Vel0, Status, PairMeta],
             ..S::row(Stage::Integrate, "integrate", INTEGRATE_PASS, Part::Integrate)
-        },
-        S {
-            over: Over::Manifolds,
-            runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
-            writes: SNAP_WRITES,
-            ..S::row(Stage::SolveContactsFirst, "solve_contacts_first", SOLVE_PASS, Part::Solve)
         },
         S {
             over: Over::Manifolds,
@@ -306,8 +298,8 @@ pub(crate) const TABLE: [StageInfo; 22] = {
         S {
             over: Over::Manifolds,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, Points, Points1, Points2, Points3],
-            writes: &[Snaps, Snaps1],
+            reads: &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            writes: SNAP_WRITES,
             ..S::row(Stage::RestitutionContacts, "restitution_contacts", RESTITUTION_PASS, Part::Restitution)
         },
         S {

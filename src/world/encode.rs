@@ -171,9 +171,9 @@ impl World {
     /// The passes of one step, each with the Params slot it uses within the
     /// step (`slots_per_substep` a substep; `solve_joints` one per colour):
     /// the broadphase and narrowphase once (`Runs`), then for every substep
-    /// the integration and its share of the `iterations` sweeps of the
-    /// solve's two halves (`Settings::sweeps`; the contacts, kept in the
-    /// bodies' own frames, serve all substeps), then the restitution's two.
+    /// the integration, its share of the `iterations` sweeps of the solve's
+    /// two halves (`Settings::sweeps`) and the restitution's two (the
+    /// contacts, kept in the bodies' own frames, serve all substeps).
     // For the crate's own tests and the binary's bench, not part of the guide.
     #[doc(hidden)]
     pub fn step_plan(&self) -> Vec<(Stage, usize)> {
@@ -191,8 +191,7 @@ impl World {
             let at = sub * per_substep;
             plan.push((Stage::Integrate, at));
             for sweep in 0..self.settings.sweeps(sub as u32) {
-                let contacts = if sweep == 0 { Stage::SolveContactsFirst } else { Stage::SolveContacts };
-                plan.extend([(contacts, at), (Stage::Solve, at)]);
+                plan.extend([(Stage::SolveContacts, at), (Stage::Solve, at)]);
                 if self.island_count > 0 {
                     // islands sleep as one only where bodies sleep at all
                     if sweep == 0 && self.settings.sleeping {
@@ -201,9 +200,10 @@ impl World {
                     plan.extend((1..per_substep).map(|c| (Stage::SolveJoints, at + c)));
                 }
             }
-            // once a step, after its last substep (restitution.wgsl)
+            plan.push((Stage::RestitutionContacts, at));
+            // the next substep's integrate applies what it asks (integrate.wgsl)
             if sub + 1 == self.settings.substeps as usize {
-                plan.extend([(Stage::RestitutionContacts, at), (Stage::Restitution, at)]);
+                plan.push((Stage::Restitution, at));
             }
         }
         plan
