@@ -72,13 +72,14 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     let threshold = max(2.0 * length(params.gravity) * params.dt, RESTITUTION_THRESHOLD);
     let mu = combined_friction(ea, eb);
     let e = combined_restitution(ea, eb);
-    // against an end that stays, each contact cuts at most its share of the
-    // sliding (friction_split; read only then, and never both ends stay here)
-    var split = 1.0;
+    // each contact cuts at most its share of the sliding: friction_split
+    // against an end that stays (never both ends stay here), else sliding_split
+    var split_a = sliding_split(a);
+    var split_b = sliding_split(b);
     if (!eb.moves) {
-        split = friction_split(a, 1.0);
+        split_a = friction_split(a, 1.0);
     } else if (!ea.moves) {
-        split = friction_split(b, 1.0);
+        split_b = friction_split(b, 1.0);
     }
     // summed over the points: the velocity change asked of b (a gets the opposite;
     // times the inverse masses later), its moments; the bounces apart, with their 1 / w
@@ -113,9 +114,9 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
             // Coulomb's bound is on the impulse: mu times the normal one (the
             // push through the inverse mass along n); bounding the velocity
             // change instead gave a sliding ball 3.5 times too little friction
-            let w_t = end_inv_mass(ea, ra, t) + end_inv_mass(eb, rb, t);
+            let w_t = end_inv_mass(ea, ra, t) * split_a + end_inv_mass(eb, rb, t) * split_b;
             let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
-            let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / (split * w_t));
+            let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / w_t);
             impulse = impulse + t * j;
             acted = true;
         }
