@@ -91,6 +91,25 @@ fn edits_within_the_room_keep_the_worlds_buffers() {
     assert!(w.read_state().is_ok());
 }
 
+/// The last body removed leaves an empty world that steps; bodies added to
+/// it then fall as in a world made with them.
+#[test]
+fn a_world_emptied_and_filled_again_steps_as_one_made_full() {
+    let Some(mut w) = world(&scenes::stack(1)) else { return };
+    w.step(10).unwrap();
+    w.remove_body(0).unwrap();
+    assert_eq!(w.body_count(), 0);
+    w.step(10).unwrap();
+    assert!(w.read_state().unwrap().is_empty());
+    let scene = scenes::stack(3);
+    assert_eq!(w.add_bodies(&scene.bodies, &[]).unwrap(), 0..3);
+    let mut made = world(&scene).unwrap();
+    made.restore(&w.snapshot().unwrap()).expect("the same scene");
+    w.step(40).unwrap();
+    made.step(40).unwrap();
+    assert!(raw_bytes(&w) == raw_bytes(&made), "the refilled world parted from one made full");
+}
+
 /// The step's kernels are compiled once per device: the same source,
 /// entry point, layouts and constants give the same pipeline, and the same
 /// entries the same bind group layout.
