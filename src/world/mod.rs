@@ -74,9 +74,10 @@ pub struct World {
     time: f64,
     /// Length of the last (sub)step taken (s): what `disp` spans.
     dt_prev: f32,
-    /// The user-input kernels (`input.rs`), built on the first input.
+    /// The user-input kernels' buffers and bind groups (`input.rs`), made
+    /// on the first input and again on the first after an edit.
     input: Option<input::InputGpu>,
-    /// The scene as loaded or last edited (`edit.rs` rebuilds from it).
+    /// The scene as loaded or last edited (`edit.rs` edits it).
     scene: Scene,
     /// How full the contact pools got (`World::fit_pools`).
     pools: PoolWatch,
