@@ -12,6 +12,7 @@ pub mod status;
 #[doc(hidden)]
 pub mod types;
 
+use std::collections::HashMap;
 use std::fmt;
 
 /// Why no GPU could be had.
@@ -68,6 +69,30 @@ pub struct Gpu {
     /// upstream in gfx-rs/wgpu#9958). Threads that share a `Gpu` (the tests
     /// do) poll one at a time.
     polling: std::sync::Mutex<()>,
+    /// Every compute kernel and bind group layout made so far, kept for the
+    /// device's life: a second world, or an edit, compiles nothing.
+    kernels: std::sync::Mutex<Kernels>,
+}
+
+/// The compiled compute pipelines of a device and the bind group layouts
+/// they were made for (`Gpu::compute_pipelines`, `Gpu::bind_group_layout`).
+#[derive(Default)]
+struct Kernels {
+    /// By their entries; the label is the first maker's.
+    layouts: HashMap<Vec<wgpu::BindGroupLayoutEntry>, wgpu::BindGroupLayout>,
+    pipelines: HashMap<KernelKey, wgpu::ComputePipeline>,
+}
+
+/// All that a compute pipeline is made from: the same key, the same kernel.
+#[derive(PartialEq, Eq, Hash)]
+struct KernelKey {
+    source: String,
+    entry: String,
+    /// The bind group layouts (by identity: the cached ones are the same
+    /// handles each time), or None for the shader's own.
+    groups: Option<Vec<wgpu::BindGroupLayout>>,
+    /// Override constants, by name and the bits of their value.
+    constants: Vec<(String, u64)>,
 }
 
 impl fmt::Debug for Gpu {
@@ -81,10 +106,42 @@ impl Gpu {
     /// the one way every compute kernel here is built (the step's passes,
     /// the input kernels, the bench's copy kernel). `bind_groups`: the
     /// layouts of its bind groups, or None to take them from the shader
-    /// (`get_bind_group_layout`); `constants`: override constants.
+    /// (`get_bind_group_layout`); `constants`: override constants. Each is
+    /// compiled once per device and kept (the same source, entry point,
+    /// layouts and constants give the same pipeline): compiling the step's
+    /// passes takes a fifth of a second on a software adapter.
     // For the crate's own tests, not part of the guide.
     #[doc(hidden)]
     pub fn compute_pipelines(
+        &self,
+        label: &str,
+        source: &str,
+        entries: &[&str],
+        bind_groups: Option<&[&wgpu::BindGroupLayout]>,
+        constants: &[(&str, f64)],
+    ) -> Vec<wgpu::ComputePipeline> {
+        let key = |entry: &str| KernelKey {
+            source: source.to_string(),
+            entry: entry.to_string(),
+            groups: bind_groups.map(|groups| groups.iter().map(|&g| g.clone()).collect()),
+            constants: constants.iter().map(|&(name, value)| (name.to_string(), value.to_bits())).collect(),
+        };
+        let keys: Vec<KernelKey> = entries.iter().map(|e| key(e)).collect();
+        let cached: Vec<Option<wgpu::ComputePipeline>> = {
+            let kernels = self.kernels.lock().unwrap_or_else(|e| e.into_inner());
+            keys.iter().map(|k| kernels.pipelines.get(k).cloned()).collect()
+        };
+        if cached.iter().all(Option::is_some) {
+            return cached.into_iter().flatten().collect();
+        }
+        // compiled outside the lock: other threads' kernels need not wait
+        let made = self.compile_pipelines(label, source, entries, bind_groups, constants);
+        let mut kernels = self.kernels.lock().unwrap_or_else(|e| e.into_inner());
+        // where another thread compiled one meanwhile, its pipeline is kept
+        keys.into_iter().zip(made).map(|(k, p)| kernels.pipelines.entry(k).or_insert(p).clone()).collect()
+    }
+
+    fn compile_pipelines(
         &self,
         label: &str,
         source: &str,
@@ -121,6 +178,21 @@ impl Gpu {
                 })
             })
             .collect()
+    }
+
+    /// A bind group layout of `entries`, made once per device and kept, so
+    /// that the pipelines made for it are found again (`compute_pipelines`).
+    // For the crate's own tests, not part of the guide.
+    #[doc(hidden)]
+    pub fn bind_group_layout(&self, label: &str, entries: &[wgpu::BindGroupLayoutEntry]) -> wgpu::BindGroupLayout {
+        let mut kernels = self.kernels.lock().unwrap_or_else(|e| e.into_inner());
+        kernels
+            .layouts
+            .entry(entries.to_vec())
+            .or_insert_with(|| {
+                self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+            })
+            .clone()
     }
 
     /// Opens the adapter that wgpu's environment variables select
@@ -213,7 +285,17 @@ impl Gpu {
                 });
             }
         });
-        Ok(Gpu { adapter, device, queue, info, limits, errors, lost, polling: std::sync::Mutex::new(()) })
+        Ok(Gpu {
+            adapter,
+            device,
+            queue,
+            info,
+            limits,
+            errors,
+            lost,
+            polling: std::sync::Mutex::new(()),
+            kernels: std::sync::Mutex::new(Kernels::default()),
+        })
     }
 
     /// The most loop trips one invocation may take, summed over all of its
@@ -270,14 +352,26 @@ impl Gpu {
 
     /// Copies `size` bytes of `src` to the host (a blocking readback).
     pub(crate) fn read_buffer(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
+        Ok(self.read_buffers(&[(src, size)])?.remove(0))
+    }
+
+    /// Copies the first `size` bytes of each buffer to the host, in one
+    /// submission and one wait (a blocking readback); each size a multiple
+    /// of 4.
+    pub(crate) fn read_buffers(&self, sources: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>, GpuError> {
+        let total: u64 = sources.iter().map(|&(_, size)| size).sum();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
-            size,
+            size: total,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
-        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        let mut at = 0;
+        for &(src, size) in sources {
+            enc.copy_buffer_to_buffer(src, 0, &staging, at, size);
+            at += size;
+        }
         self.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
@@ -291,7 +385,15 @@ impl Gpu {
             .map_err(|e| GpuError::Runtime(e.to_string()))?;
         let bytes = staging.get_mapped_range(..).map_err(|e| GpuError::Runtime(e.to_string()))?.to_vec();
         staging.unmap();
-        Ok(bytes)
+        let mut at = 0;
+        Ok(sources
+            .iter()
+            .map(|&(_, size)| {
+                let part = bytes[at as usize..(at + size) as usize].to_vec();
+                at += size;
+                part
+            })
+            .collect())
     }
 }
 

@@ -371,4 +371,6 @@ mod write;
 use load::*;
 use validate::*;
 
-pub(crate) use validate::{dt_too_short, mass_problem, position_problem, speed_problem, spin_problem};
+pub(crate) use validate::{
+    check_sink, dt_too_short, mass_problem, position_problem, speed_problem, spin_problem, validate_body, validate_joint,
+};

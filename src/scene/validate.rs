@@ -79,7 +79,7 @@ pub(crate) fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
 /// passes a tenth of the smallest moving body's bounding radius, or where it
 /// pushes in faster than `MAX_DEPENETRATION_SPEED` pushes out (figures in
 /// docs/limits.md). Only gravity's part along -y counts.
-pub(super) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError> {
+pub(crate) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError> {
     let Some(smallest) = bodies.iter().filter(|b| !b.fixed).map(|b| b.bounding_radius()).reduce(f32::min) else {
         return Ok(());
     };
@@ -163,7 +163,7 @@ pub(crate) fn spin_problem(w: [f32; 3], h: f32) -> Option<String> {
     None
 }
 
-pub(super) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Result<(), SceneError> {
+pub(crate) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Result<(), SceneError> {
     check_shape(&body.shape, &format!("{path}.shape"))?;
     check_all_finite(&body.position, &format!("{path}.position"))?;
     check_orientation(body.orientation, &format!("{path}.orientation"))?;
@@ -229,7 +229,7 @@ pub(super) fn inverse_problem(body: &Body) -> Option<String> {
     ))
 }
 
-pub(super) fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Result<(), SceneError> {
+pub(crate) fn validate_joint(joint: &Joint, body_count: usize, path: &str) -> Result<(), SceneError> {
     for (k, &index) in joint.bodies.iter().enumerate() {
         let in_range = index == WORLD || (index >= 0 && (index as i64) < body_count as i64);
         if !in_range {

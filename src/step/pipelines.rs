@@ -38,9 +38,9 @@ fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry { binding: buffer.binding(), visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
 }
 
-/// Compiles one pass with its layout (the override constants: POOL_SPLIT,
+/// One pass for its layout (the override constants: POOL_SPLIT,
 /// DISPATCH_ROW from the device's limits, the stage's own from its row,
-/// LOOP_TRIPS where the driver limits loops).
+/// LOOP_TRIPS where the driver limits loops), compiled once per device.
 fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: bool) -> wgpu::ComputePipeline {
     let mut constants = vec![
         ("POOL_SPLIT", f64::from(u8::from(pool_split))),
@@ -55,23 +55,23 @@ fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: 
 }
 
 impl StepPipelines {
-    /// Compiles the step's passes, for a manifold pool in parts where
-    /// `pool_split` (see `World::make_pools`).
+    /// The step's passes, for a manifold pool in parts where `pool_split`
+    /// (see `World::make_pools`): compiled on the device's first world, and
+    /// found again (`Gpu::compute_pipelines`) by every other and every edit.
     pub(crate) fn new(gpu: &Gpu, pool_split: bool) -> StepPipelines {
-        let device = &gpu.device;
         let layouts: Vec<wgpu::BindGroupLayout> = Stage::ALL
             .iter()
             .map(|stage| {
                 let entries: Vec<wgpu::BindGroupLayoutEntry> = stage.buffers().into_iter().map(entry).collect();
-                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(stage.name()), entries: &entries })
+                gpu.bind_group_layout(stage.name(), &entries)
             })
             .collect();
         let pipelines = Stage::ALL.iter().map(|&stage| compile(gpu, stage, &layouts[stage as usize], pool_split)).collect();
         StepPipelines { layouts, pipelines, pool_split }
     }
 
-    /// Compiles the passes that touch the manifold pool's parts again, for
-    /// a pool in parts (POOL_SPLIT on; see `World::make_pools`).
+    /// The passes that touch the manifold pool's parts, compiled for a pool
+    /// in parts (POOL_SPLIT on; see `World::make_pools`), once per device.
     pub(crate) fn split_pool(&mut self, gpu: &Gpu) {
         for stage in Stage::ALL {
             let buffers = stage.buffers();

@@ -6,14 +6,14 @@ use bytemuck::{Pod, Zeroable};
 
 use super::capacity::{pair_capacities, pool_parts};
 use super::encode::MAX_BATCH;
-use super::records::{GridLayout, JointLists};
+use super::records::{hash_size, JointLists};
 use crate::gpu::status::Status;
 use crate::gpu::{types::*, Gpu};
 use crate::step::{Buffer, Over, Stage, StepPipelines};
 
-/// The GPU buffers of a world, made at start-up; only the pair list and the
-/// manifold pool are made again (`World::make_pools`), as the contacts a
-/// step wants grow or shrink.
+/// The GPU buffers of a world, made at start-up; the pair list and the
+/// manifold pool are made again as the contacts a step wants grow or
+/// shrink (`World::make_pools`), the rest as an edit needs (`refit`).
 pub(super) struct WorldData {
     pub states: [wgpu::Buffer; 2],
     pub params: wgpu::Buffer,
@@ -85,71 +85,39 @@ pub(super) const DISPATCH_BYTES: u64 = size_of::<[u32; 3]>() as u64;
 
 impl WorldData {
     /// Makes and fills the buffers of a scene of `n` bodies (`props`,
-    /// `states`, the bodies kept out of the grid `large`, `joints`).
-    #[allow(clippy::too_many_arguments)]
+    /// `states`, the bodies kept out of the grid `large`, `joints`), with
+    /// room for exactly those bodies.
     pub(crate) fn new(
         gpu: &Gpu,
         n: usize,
         props: &[BodyProps],
         states: &[BodyState],
         large: &[u32],
-        grid: &GridLayout,
         joints: &JointLists,
         substeps: u32,
     ) -> WorldData {
         let device = &gpu.device;
-        let count = n.max(1); // wgpu buffers may not be empty
         let storage = |label: &str, size: u64| storage_buffer(device, label, size);
-        let with_data = |label: &str, bytes: &[u8]| {
-            let buf = storage(label, bytes.len() as u64);
-            if !bytes.is_empty() {
-                gpu.queue.write_buffer(&buf, 0, bytes);
-            }
-            buf
-        };
-        let hash = grid.hash_size as u64;
-        let props_buf = with_data("props", bytemuck::cast_slice(props));
-        let state_bufs = [with_data("state A", bytemuck::cast_slice(states)), with_data("state B", bytemuck::cast_slice(states))];
-        let vel0 = storage("vel0", (count * size_of::<Velocity>()) as u64);
-        let cell_count = storage("grid/cell_count", 4 * hash);
-        let cell_start = storage("grid/cell_start", 4 * (hash + 1));
-        // block totals of the grid's scan and the pairs' (xy)
-        let block_sums = storage("scan/block_sums", 8 * hash.max(count as u64).div_ceil(SCAN_SPAN as u64));
-        // the grid's order, then the step's listed bodies (`listed_body` in bindings.wgsl)
-        let sorted = storage("grid/sorted", 8 * count as u64);
-        // the grid bodies' bounds in the grid's order (grid_sort, for the pair walks)
-        let cell_bounds = storage("grid/cell_bounds", (count * size_of::<CellBound>()) as u64);
-        let large_buf = with_data("grid/large", bytemuck::cast_slice(large));
-        let (pair_capacity, manifold_capacity) = pair_capacities(gpu, count as u64);
+        let room = n.max(1); // wgpu buffers may not be empty
+        let BodyBuffers { states: state_bufs, batch_state, scratch, pair_meta } = BodyBuffers::new(device, room);
+        let (pair_capacity, manifold_capacity) = pair_capacities(gpu, room as u64);
         let pairs = storage("pairs", pair_capacity * size_of::<Pair>() as u64);
         let (heads, point_parts, snap_parts) = pool_parts(gpu, manifold_capacity);
         let manifolds = storage("manifolds", heads);
         let points = point_parts.map(|size| storage("manifolds/points", size));
         let snaps = snap_parts.map(|size| storage("manifolds/snaps", size));
-        let meta_bytes = (count as u64 + 1) * size_of::<PairMeta>() as u64;
-        let pair_meta = storage("pairs/meta", meta_bytes);
-        let state_bytes = (count * size_of::<BodyState>()) as u64;
         let body_pairs = storage("pairs/body_lists", 2 * pair_capacity * 4);
-        let status = with_data("status", bytemuck::bytes_of(&Status::INIT));
+        let status = storage("status", Status::BYTES);
+        gpu.queue.write_buffer(&status, 0, bytemuck::bytes_of(&Status::INIT));
         let dispatch = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("indirect dispatches"),
             size: size_of::<Dispatches>() as u64,
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let joint_start = with_data("joints/start", bytemuck::cast_slice(&joints.starts));
-        let joint_refs = with_data("joints/refs", bytemuck::cast_slice(&joints.refs));
-        // a batch's substeps' slots, each substep's own and one per colour of joint paths
-        let slots = MAX_BATCH.max(substeps as usize * (1 + joints.colour_count() as usize));
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("params"),
-            size: PARAMS_STRIDE * slots as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        WorldData {
+        let data = WorldData {
             states: state_bufs,
-            params,
+            params: params_buffer(device, substeps, joints),
             status,
             pairs,
             manifolds,
@@ -159,11 +127,82 @@ impl WorldData {
             body_pairs,
             dispatch,
             bind_groups: None,
-            props: props_buf,
-            statics: [large_buf, joint_start, joint_refs],
-            scratch: [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds],
-            batch_start: [storage("batch start/state", state_bytes), storage("batch start/status", Status::BYTES)],
+            props: props_buffer(device, n),
+            statics: statics_buffers(device, large, joints),
+            scratch,
+            batch_start: [batch_state, storage("batch start/status", Status::BYTES)],
+        };
+        data.upload(gpu, props, states, large, joints);
+        data
+    }
+
+    /// This world's buffers made over for an edited scene of `n` bodies
+    /// (`large` of them kept out of the grid, `joints`), nothing written
+    /// yet: those sized by the body count where they hold `n` (else all of
+    /// them anew, with room for `room`), the properties and the statics
+    /// anew at their exact sizes (the scene hash reads them whole), the
+    /// Params slots where the joint paths' colours need more, the rest (the
+    /// contact pools, which follow the need) as they are. Takes the same
+    /// handles, so nothing of this world changes until the caller writes.
+    pub(super) fn refit(&self, gpu: &Gpu, n: usize, room: usize, large: &[u32], joints: &JointLists, substeps: u32) -> WorldData {
+        let device = &gpu.device;
+        let (states, batch_state, scratch, pair_meta) = if self.body_room() >= n.max(1) {
+            (self.states.clone(), self.batch_start[0].clone(), self.scratch.clone(), self.pair_meta.clone())
+        } else {
+            let BodyBuffers { states, batch_state, scratch, pair_meta } = BodyBuffers::new(device, room.max(n).max(1));
+            (states, batch_state, scratch, pair_meta)
+        };
+        let params = if self.params.size() >= params_bytes(substeps, joints) {
+            self.params.clone()
+        } else {
+            params_buffer(device, substeps, joints)
+        };
+        WorldData {
+            states,
+            params,
+            status: self.status.clone(),
+            pairs: self.pairs.clone(),
+            manifolds: self.manifolds.clone(),
+            points: self.points.clone(),
+            snaps: self.snaps.clone(),
+            pair_meta,
+            body_pairs: self.body_pairs.clone(),
+            dispatch: self.dispatch.clone(),
+            bind_groups: None,
+            props: props_buffer(device, n),
+            statics: statics_buffers(device, large, joints),
+            scratch,
+            batch_start: [batch_state, self.batch_start[1].clone()],
         }
+    }
+
+    /// Writes a scene's records: the properties, the poses (into both
+    /// state buffers: a body the step leaves as it is is read from either,
+    /// `listed_body` in bindings.wgsl), the statics, and the bodies kept
+    /// out of the grid into the tail of the grid's part of `sorted`, where
+    /// the passes read them.
+    pub(super) fn upload(&self, gpu: &Gpu, props: &[BodyProps], states: &[BodyState], large: &[u32], joints: &JointLists) {
+        let queue = &gpu.queue;
+        let write = |buffer: &wgpu::Buffer, at: u64, bytes: &[u8]| {
+            if !bytes.is_empty() {
+                queue.write_buffer(buffer, at, bytes);
+            }
+        };
+        write(&self.props, 0, bytemuck::cast_slice(props));
+        for to in &self.states {
+            write(to, 0, bytemuck::cast_slice(states));
+        }
+        let [large_buf, joint_start, joint_refs] = &self.statics;
+        write(large_buf, 0, bytemuck::cast_slice(large));
+        write(joint_start, 0, bytemuck::cast_slice(&joints.starts));
+        write(joint_refs, 0, bytemuck::cast_slice(&joints.refs));
+        // the grid's part of `sorted` holds the other bodies, n - large of them
+        write(self.sorted(), 4 * (states.len() - large.len()) as u64, bytemuck::cast_slice(large));
+    }
+
+    /// Bodies the buffers sized by the body count hold.
+    pub(super) fn body_room(&self) -> usize {
+        (self.states[0].size() / size_of::<BodyState>() as u64) as usize
     }
 
     /// `sorted`: the grid's order, then the bodies the step's body passes
@@ -258,6 +297,73 @@ pub(super) fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> w
         label: Some(label),
         size: size.max(64),
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// The buffers whose size follows the body count, for `room` bodies: the
+/// poses, the batch's copy of them, the passes' working buffers (the
+/// grid's hash table at the size `plan_grid` gives that many bodies) and
+/// each body's pair bookkeeping.
+struct BodyBuffers {
+    states: [wgpu::Buffer; 2],
+    batch_state: wgpu::Buffer,
+    scratch: [wgpu::Buffer; 6],
+    pair_meta: wgpu::Buffer,
+}
+
+impl BodyBuffers {
+    fn new(device: &wgpu::Device, room: usize) -> BodyBuffers {
+        let storage = |label: &str, size: u64| storage_buffer(device, label, size);
+        let count = room as u64;
+        let hash = hash_size(room) as u64;
+        let state_bytes = count * size_of::<BodyState>() as u64;
+        let vel0 = storage("vel0", count * size_of::<Velocity>() as u64);
+        let cell_count = storage("grid/cell_count", 4 * hash);
+        let cell_start = storage("grid/cell_start", 4 * (hash + 1));
+        // block totals of the grid's scan and the pairs' (xy)
+        let block_sums = storage("scan/block_sums", 8 * hash.max(count).div_ceil(SCAN_SPAN as u64));
+        // the grid's order, then the step's listed bodies (`listed_body` in bindings.wgsl)
+        let sorted = storage("grid/sorted", 8 * count);
+        // the grid bodies' bounds in the grid's order (grid_sort, for the pair walks)
+        let cell_bounds = storage("grid/cell_bounds", count * size_of::<CellBound>() as u64);
+        BodyBuffers {
+            states: [storage("state A", state_bytes), storage("state B", state_bytes)],
+            batch_state: storage("batch start/state", state_bytes),
+            scratch: [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds],
+            // one more: the pair scan's total
+            pair_meta: storage("pairs/meta", (count + 1) * size_of::<PairMeta>() as u64),
+        }
+    }
+}
+
+/// The bodies' properties, exactly `n` of them (at least one element).
+fn props_buffer(device: &wgpu::Device, n: usize) -> wgpu::Buffer {
+    storage_buffer(device, "props", (n * size_of::<BodyProps>()) as u64)
+}
+
+/// The statics (`WorldData::statics`), exactly as large as their lists.
+fn statics_buffers(device: &wgpu::Device, large: &[u32], joints: &JointLists) -> [wgpu::Buffer; 3] {
+    [
+        storage_buffer(device, "grid/large", (4 * large.len()) as u64),
+        storage_buffer(device, "joints/start", (4 * joints.starts.len()) as u64),
+        storage_buffer(device, "joints/refs", (joints.refs.len() * size_of::<JointRef>()) as u64),
+    ]
+}
+
+/// Bytes of the Params slots of a batch: its substeps', each substep's own
+/// and one per colour of joint paths.
+fn params_bytes(substeps: u32, joints: &JointLists) -> u64 {
+    let slots = MAX_BATCH.max(substeps as usize * (1 + joints.colour_count() as usize));
+    PARAMS_STRIDE * slots as u64
+}
+
+/// The Params slots of a batch (`params_bytes`).
+fn params_buffer(device: &wgpu::Device, substeps: u32, joints: &JointLists) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("params"),
+        size: params_bytes(substeps, joints),
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
 }

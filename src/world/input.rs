@@ -529,15 +529,16 @@ impl World {
                     count: None,
                 };
                 let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
-                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("input"),
-                    entries: &[
+                // the device's own, so that its kernels are found compiled
+                let layout = self.gpu.bind_group_layout(
+                    "input",
+                    &[
                         entry(BIND_STATE, storage(false)),
                         entry(BIND_HEADER, wgpu::BufferBindingType::Uniform),
                         entry(BIND_OPS, storage(true)),
                         entry(BIND_PROPS, storage(false)),
                     ],
-                });
+                );
                 let pipelines = self.gpu.compute_pipelines("input", &source(), &ENTRY_POINTS, Some(&[&layout]), &[]);
                 let header = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("input/header"),

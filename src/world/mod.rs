@@ -74,9 +74,10 @@ pub struct World {
     time: f64,
     /// Length of the last (sub)step taken (s): what `disp` spans.
     dt_prev: f32,
-    /// The user-input kernels (`input.rs`), built on the first input.
+    /// The user-input kernels' buffers and bind groups (`input.rs`), made
+    /// on the first input and again on the first after an edit.
     input: Option<input::InputGpu>,
-    /// The scene as loaded or last edited (`edit.rs` rebuilds from it).
+    /// The scene as loaded or last edited (`edit.rs` edits it).
     scene: Scene,
     /// How full the contact pools got (`World::fit_pools`).
     pools: PoolWatch,
@@ -111,17 +112,10 @@ impl World {
         let settings = scene.settings;
         let (props, large, grid) = scene_props(scene);
         let states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &settings)).collect();
-        let mut data = WorldData::new(&gpu, n, &props, &states, &large, &grid, &joints, settings.substeps);
+        let mut data = WorldData::new(&gpu, n, &props, &states, &large, &joints, settings.substeps);
         let (_, manifold_capacity) = pair_capacities(&gpu, n.max(1) as u64);
         let pipelines = StepPipelines::new(&gpu, capacity::pool_in_parts(&gpu, manifold_capacity));
         data.bind_groups = Some(data.step_bind_groups(&gpu.device, &pipelines));
-        if !large.is_empty() {
-            // the grid's part of `sorted` holds the other bodies, n - large of them
-            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("large bodies") });
-            let [large_buf, ..] = &data.statics;
-            encoder.copy_buffer_to_buffer(large_buf, 0, data.sorted(), 4 * (n - large.len()) as u64, 4 * large.len() as u64);
-            gpu.queue.submit([encoder.finish()]);
-        }
         gpu.check()?;
         let substep_dt = settings.dt / settings.substeps as f32;
         Ok(World {

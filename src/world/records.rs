@@ -42,8 +42,13 @@ pub fn plan_grid(radii: &[f32]) -> (Vec<u32>, GridLayout) {
     let is_large = |i: usize| large.binary_search(&(i as u32)).is_ok();
     let r = (0..radii.len()).filter(|&i| !is_large(i)).map(|i| radii[i]).fold(0.0f32, f32::max).max(1e-3);
     let speculative = 0.5 * r;
-    let hash_size = (2 * radii.len()).max(1024).next_power_of_two() as u32;
-    (large, GridLayout { cell_size: 2.0 * r + speculative, hash_size, speculative })
+    (large, GridLayout { cell_size: 2.0 * r + speculative, hash_size: hash_size(radii.len()), speculative })
+}
+
+/// Buckets of the grid's hash table for `bodies` bodies: a power of two,
+/// about two per body, at least 1024.
+pub(crate) fn hash_size(bodies: usize) -> u32 {
+    (2 * bodies).max(1024).next_power_of_two() as u32
 }
 
 fn dvec(v: [f32; 3]) -> DVec3 {

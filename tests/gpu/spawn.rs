@@ -77,7 +77,7 @@ fn bad_edits_are_refused_and_change_nothing() {
     let before = w.read_raw().unwrap();
     let bad = box_body([0.5, -1.0, 0.5], [0.0, 9.0, 0.0]);
     match w.add_bodies(&[bad], &[]) {
-        Err(Error::Load(e)) => assert!(e.to_string().contains("bodies[3].shape.half_extents[1]"), "{e}"),
+        Err(Error::Input(e)) => assert!(e.starts_with("bodies[0].shape.half_extents[1]"), "{e}"),
         other => panic!("a negative size was not refused: {other:?}"),
     }
     let joint = Joint { bodies: [0, 7], anchors: [[0.0; 3], [0.0; 3]] };
