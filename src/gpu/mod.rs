@@ -68,6 +68,9 @@ pub struct Gpu {
     /// upstream in gfx-rs/wgpu#9958). Threads that share a `Gpu` (the tests
     /// do) poll one at a time.
     polling: std::sync::Mutex<()>,
+    /// Which `Gpu` of this process it is: wgpu's devices of two instances
+    /// may compare equal (wgpu-core's ids are per instance).
+    id: u64,
 }
 
 impl fmt::Debug for Gpu {
@@ -213,7 +216,9 @@ impl Gpu {
                 });
             }
         });
-        Ok(Gpu { adapter, device, queue, info, limits, errors, lost, polling: std::sync::Mutex::new(()) })
+        static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Ok(Gpu { adapter, device, queue, info, limits, errors, lost, polling: std::sync::Mutex::new(()), id })
     }
 
     /// The most loop trips one invocation may take, summed over all of its
@@ -225,6 +230,11 @@ impl Gpu {
     #[doc(hidden)]
     pub fn loop_trips(&self) -> Option<u32> {
         self.info.name.contains("llvmpipe").then_some(65_000)
+    }
+
+    /// A number no other `Gpu` of this process has: whether two are the same.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// One line naming the adapter, its backend and driver.

@@ -371,4 +371,4 @@ mod write;
 use load::*;
 use validate::*;
 
-pub(crate) use validate::{dt_too_short, mass_problem, position_problem, speed_problem, spin_problem};
+pub(crate) use validate::{mass_problem, position_problem, speed_problem, spin_problem, step_dt_problem};
