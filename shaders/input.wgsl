@@ -118,7 +118,10 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             var np = p;
             if (op.a.x == 1.0) {
                 if (!fixed) {
-                    np.kept_inv_mass = p.inv_inertia.w; // kept for a later switch back
+                    // kept for a later switch back; none where it is the scene's
+                    // mass (c), which that switch falls back to: a body made fixed
+                    // and dynamic again, or dynamic and fixed again, is as it was
+                    np.kept_inv_mass = select(p.inv_inertia.w, 0.0, p.inv_inertia.w == op.c.w);
                 }
                 np.flags = p.flags | FLAG_FIXED;
                 np.inv_inertia = vec4<f32>(0.0);

@@ -5,6 +5,7 @@
 
 mod common;
 
+mod api_hostile;
 mod capacity;
 mod collide_reference;
 mod determinism;
