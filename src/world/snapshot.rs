@@ -177,9 +177,6 @@ impl Snapshot {
             ));
         }
         let n = u32_at(12) as usize;
-        if n as u64 > crate::scenes::MAX_BODIES {
-            return Err(format!("snapshot of {n} bodies: no world holds more than {}", crate::scenes::MAX_BODIES));
-        }
         let per_body = if version == VERSION { POSE + 1 } else { POSE };
         let expected = n.checked_mul(per_body).and_then(|p| p.checked_add(HEADER + TRAILER));
         if expected != Some(bytes.len()) {
@@ -188,6 +185,9 @@ impl Snapshot {
                 expected.map_or("too many".to_string(), |e| e.to_string()),
                 bytes.len()
             ));
+        }
+        if n as u64 > crate::scenes::MAX_BODIES {
+            return Err(format!("snapshot of {n} bodies: no world holds more than {}", crate::scenes::MAX_BODIES));
         }
         let body_end = bytes.len() - TRAILER;
         let stored = u64_at(body_end);
@@ -322,18 +322,24 @@ impl Snapshot {
         let mut bytes = Vec::with_capacity(HEADER);
         (&mut reader).take(HEADER as u64).read_to_end(&mut bytes).map_err(io)?;
         // the header says how long the file is: read one byte more, to tell padding
-        let expected = Snapshot::expected_len(&bytes).map_err(refuse)?;
+        let (n, expected) = Snapshot::expected_len(&bytes).map_err(refuse)?;
+        if expected > MAX_BYTES {
+            return Err(refuse(format!(
+                "snapshot of {n} bodies should be {expected} bytes, more than a snapshot of the most bodies any world \
+                 holds ({MAX_BYTES} bytes)"
+            )));
+        }
         if let Some(len) = known.filter(|&len| len != expected) {
-            return Err(refuse(format!("snapshot should be {expected} bytes but is {len} (truncated or padded)")));
+            return Err(refuse(format!("snapshot of {n} bodies should be {expected} bytes but is {len} (truncated or padded)")));
         }
         bytes.reserve((expected as usize).saturating_sub(HEADER));
         reader.take(expected + 1 - HEADER as u64).read_to_end(&mut bytes).map_err(io)?;
         Snapshot::from_bytes(&bytes).map_err(refuse)
     }
 
-    /// The length of the file whose first bytes are `header`, from its body
-    /// count and version, or why those are not a snapshot's.
-    fn expected_len(header: &[u8]) -> Result<u64, String> {
+    /// The body count and the length of the file whose first bytes are
+    /// `header`, from its version, or why those are not a snapshot's.
+    fn expected_len(header: &[u8]) -> Result<(u64, u64), String> {
         if header.len() < MAGIC.len() || &header[..MAGIC.len()] != MAGIC {
             return Err("not a verlet snapshot (no VRLTSNAP header)".into());
         }
@@ -347,11 +353,8 @@ impl Snapshot {
                 "snapshot version {version} is not supported (this build reads versions {VERSION_PREV_POS} to {VERSION})"
             ));
         }
-        if n > crate::scenes::MAX_BODIES {
-            return Err(format!("snapshot of {n} bodies: no world holds more than {}", crate::scenes::MAX_BODIES));
-        }
         let per_body = if version == VERSION { POSE + 1 } else { POSE } as u64;
-        Ok((HEADER + TRAILER) as u64 + n * per_body)
+        Ok((n, (HEADER + TRAILER) as u64 + n * per_body))
     }
 }
 
