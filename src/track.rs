@@ -251,9 +251,7 @@ impl Track {
     fn steps(e: &Event, dt: f32) -> (u64, u64) {
         let first = Track::step_of(e.t, dt);
         match &e.action {
-            Action::Wind { duration, .. } => {
-                (first, Track::step_of(e.t + *duration as f64, dt).max(first.saturating_add(1)))
-            }
+            Action::Wind { duration, .. } => (first, Track::step_of(e.t + *duration as f64, dt).max(first.saturating_add(1))),
             _ => (first, first.saturating_add(1)),
         }
     }

@@ -398,7 +398,6 @@ impl Canvas {
         }
     }
 
-
     /// Rewrites the instance record in `slot` (a body's new colour).
     pub(super) fn write_body(&self, slot: u32, body: &RenderBody) {
         let offset = slot as u64 * std::mem::size_of::<RenderBody>() as u64;

@@ -204,8 +204,7 @@ impl Renderer {
         }
         if world.gpu().id() != self.gpu {
             return Err(Error::Input(
-                "render: the world runs on another Gpu than the renderer was made on (make the renderer with world.gpu())"
-                    .into(),
+                "render: the world runs on another Gpu than the renderer was made on (make the renderer with world.gpu())".into(),
             ));
         }
         let state = (self.body_count > 0).then(|| world.current_state_buffer());

@@ -300,9 +300,8 @@ pub(crate) fn duration_problem(duration: f32) -> Option<String> {
 pub(crate) fn gust_problem(velocity: [f32; 3], gust: f32) -> Option<String> {
     use crate::limits::MAX_SPEED;
     let peak = length(velocity) * (1.0 + gust as f64);
-    (peak > MAX_SPEED as f64).then(|| {
-        format!("gusts of {gust:e} blow the wind at up to {peak:.4e} m/s; at most {MAX_SPEED:e} m/s is sane")
-    })
+    (peak > MAX_SPEED as f64)
+        .then(|| format!("gusts of {gust:e} blow the wind at up to {peak:.4e} m/s; at most {MAX_SPEED:e} m/s is sane"))
 }
 
 /// Why a wind's air density (kg/m^3) is absurd, if it is.
@@ -474,11 +473,7 @@ impl World {
     /// The op of a wind at the world's current time (a duration of 0 blows nothing).
     fn wind_op(&self, wind: &Wind, duration: f32) -> InputOp {
         let u = wind.at(self.time);
-        InputOp {
-            a: [u[0], u[1], u[2], 0.5 * wind.air_density * wind.drag],
-            b: [duration, 0.0, 0.0, 0.0],
-            ..Default::default()
-        }
+        InputOp { a: [u[0], u[1], u[2], 0.5 * wind.air_density * wind.drag], b: [duration, 0.0, 0.0, 0.0], ..Default::default() }
     }
 
     /// Dispatches `kernel` (explode or wind) over a list of its ops, in

@@ -250,9 +250,7 @@ impl Snapshot {
         // the substep of the shortest and the longest step a world takes
         let shortest = MIN_SUBSTEP as f64 * (1.0 - 1e-6);
         if !(h.is_finite() && h as f64 >= shortest && h <= MAX_DT) {
-            return Some(format!(
-                "snapshot dt_prev {h} is not a substep a world takes (from {MIN_SUBSTEP:e} to {MAX_DT} s)"
-            ));
+            return Some(format!("snapshot dt_prev {h} is not a substep a world takes (from {MIN_SUBSTEP:e} to {MAX_DT} s)"));
         }
         let margin = SNAPSHOT_MARGIN;
         let length = |v: &[f32]| v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
@@ -262,7 +260,7 @@ impl Snapshot {
             if words.iter().any(|v| v.iter().any(|x| !x.is_finite())) {
                 return Some(at("a non-finite number in its state"));
             }
-            if !(s.rest_time >= 0.0) {
+            if s.rest_time < 0.0 {
                 return Some(at(&format!("time at rest {} is negative", s.rest_time)));
             }
             let distance = length(&s.pos);

@@ -322,9 +322,8 @@ fn renderer_sizes_and_colours_name_their_argument() {
 fn winds_and_explosions_given_together_act_as_one_by_one() {
     let scene = scenes::pile(40, 3);
     let (Some(mut together), Some(mut apart)) = (world(&scene), world(&scene)) else { return };
-    let winds: Vec<(Wind, f32)> = (0..50)
-        .map(|k| (Wind { velocity: [3.0 + 0.1 * k as f32, 0.0, -1.0], gust: 0.3, ..Wind::default() }, 1.0 / 60.0))
-        .collect();
+    let winds: Vec<(Wind, f32)> =
+        (0..50).map(|k| (Wind { velocity: [3.0 + 0.1 * k as f32, 0.0, -1.0], gust: 0.3, ..Wind::default() }, 1.0 / 60.0)).collect();
     let blasts = [([0.0, 0.5, 0.0], 40.0, 4.0, 1.0), ([1.0, 0.0, 0.0], -25.0, 3.0, 2.0), ([0.0; 3], 10.0, 6.0, 0.0)];
     together.apply_winds(&winds).unwrap();
     for (wind, d) in &winds {
