@@ -1,6 +1,7 @@
 // User input between steps (src/world/input.rs): `apply_inputs`, one thread
 // per run of ops on one body (impulses, poses, velocities, fixed/dynamic
-// switches), and `explode` and `wind`, one thread per body. It binds only
+// switches), and `explode` and `wind`, one thread per body applying every
+// explosion or wind of the op list in order. It binds only
 // state_out (the current state, rewritten in place) and its own buffers.
 // Verlet's velocity is implicit, so a velocity change rewrites the previous
 // pose: v = disp / h and rot * prev_rot^* = exp(w h), h the last substep.
@@ -8,9 +9,6 @@
 struct InputHeader {
     gravity: vec3<f32>, // settings.gravity (m/s^2)
     substep_dt: f32,    // h, the last substep (s)
-    centre: vec4<f32>,  // explode: xyz = centre (m); w = strength, an impulse (N s)
-                        // wind: xyz = wind velocity (m/s); w = air density * drag coefficient / 2
-    reach: vec4<f32>,   // explode: x = radius (m), y = falloff exponent; wind: x = duration (s)
     counts: vec4<u32>,  // x = body_count, y = ops in input_ops
 }
 
@@ -32,8 +30,15 @@ struct InputOp {
 // INPUT_POSE: a.xyz = position, b = unit orientation; velocities are kept
 // INPUT_VELOCITY: a.xyz = linear (m/s), b.xyz = angular (rad/s, world frame)
 // INPUT_FIXED: a.x = 1: make fixed; a.x = 0: make dynamic with mass a.y (kg),
-//   or with the mass kept when it was made fixed (kept_inv_mass) if a.y = 0,
-//   or for a body loaded fixed (none kept) the scene's mass, a.z
+//   whose inverse inertia and mass the host worked out as b (a body already
+//   dynamic takes it too, keeping its velocities), or if a.y = 0 with the mass
+//   kept when it was made fixed (kept_inv_mass), or for a body loaded fixed
+//   (none kept) the scene's mass a.z, whose inverse inertia and mass are c
+// The explode and wind kernels read their own ops (one per explosion or wind):
+// explode: a.xyz = centre (m), a.w = strength, an impulse (N s); b.x = radius
+//   (m), b.y = falloff exponent
+// wind: a.xyz = wind velocity (m/s), a.w = air density * drag coefficient / 2;
+//   b.x = duration (s)
 
 // and bindings.wgsl's state_out (binding 3): the current state buffer
 @group(0) @binding(20) var<uniform> input: InputHeader;
@@ -113,7 +118,10 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             var np = p;
             if (op.a.x == 1.0) {
                 if (!fixed) {
-                    np.kept_inv_mass = p.inv_inertia.w; // kept for a later switch back
+                    // kept for a later switch back; none where it is the scene's
+                    // mass (c), which that switch falls back to: a body made fixed
+                    // and dynamic again, or dynamic and fixed again, is as it was
+                    np.kept_inv_mass = select(p.inv_inertia.w, 0.0, p.inv_inertia.w == op.c.w);
                 }
                 np.flags = p.flags | FLAG_FIXED;
                 np.inv_inertia = vec4<f32>(0.0);
@@ -121,18 +129,26 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 s.pos_low = s.pos_low | HELD;
                 s.prev_rot = s.rot;
             } else if (fixed) {
-                // the mass given, else the one kept when made fixed, else the scene's
-                var m = op.a.y;
-                if (m <= 0.0) {
-                    m = select(op.a.z, 1.0 / np.kept_inv_mass, np.kept_inv_mass > 0.0);
+                // the mass given, else the one kept when made fixed, else the
+                // scene's: the host's figures where it has them, so that a body
+                // made fixed and dynamic again has its properties back bit for bit
+                if (op.a.y > 0.0) {
+                    np.inv_inertia = op.b;
+                } else if (np.kept_inv_mass > 0.0 && np.kept_inv_mass != op.c.w) {
+                    let kept = np.kept_inv_mass;
+                    np.inv_inertia = vec4<f32>(shape_inv_inertia(p, 1.0 / kept), kept);
+                } else {
+                    np.inv_inertia = op.c;
                 }
                 np.flags = p.flags & ~FLAG_FIXED;
-                np.inv_inertia = vec4<f32>(shape_inv_inertia(p, m), 1.0 / m);
                 np.kept_inv_mass = 0.0;
                 // at rest, as the scene loader starts a body: x + g t^2 / 2 follows
                 s.disp = -0.5 * input.gravity * (h * h);
                 s.pos_low = s.pos_low & ~HELD;
                 s.prev_rot = s.rot;
+            } else if (op.a.y > 0.0) {
+                // already dynamic: the mass given, its velocities kept
+                np.inv_inertia = op.b;
             }
             *p_in = np;
         }
@@ -173,9 +189,10 @@ fn wake_all(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// A radial impulse of input.centre.w (N s) on every dynamic body within input.reach.x
-// of input.centre.xyz, scaled by (1 - d / radius) ^ falloff, away from the centre (up
-// at the centre). It changes velocity only, by J / m; bodies outside are not written.
+// Radial impulses, one per op in order: op.a.w (N s) on every dynamic body
+// within op.b.x of op.a.xyz, scaled by (1 - d / radius) ^ falloff (op.b.y),
+// away from the centre (up at the centre). They change velocity only, by
+// J / m; a body no explosion reaches is not written.
 @compute @workgroup_size(WORKGROUP)
 fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -187,26 +204,33 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     var s = out_state(i);
-    let d = s.pos - input.centre.xyz;
-    let dist = length(d);
-    let radius = input.reach.x;
-    if (!(dist < radius)) {
-        return;
+    var reached = false;
+    for (var k = 0u; k < input.counts.y; k = k + 1u) {
+        let op = input_ops[k];
+        let d = s.pos - op.a.xyz;
+        let dist = length(d);
+        let radius = op.b.x;
+        if (!(dist < radius)) {
+            continue;
+        }
+        var dir = vec3<f32>(0.0, 1.0, 0.0);
+        if (dist > 0.0) {
+            dir = d / dist;
+        }
+        let base = 1.0 - dist / radius;
+        var scale = 1.0; // pow(x, 0) is undefined at x = 0 in WGSL
+        if (op.b.y == 1.0) {
+            scale = base;
+        } else if (op.b.y != 0.0) {
+            scale = pow(base, op.b.y);
+        }
+        let dv = dir * (op.a.w * scale * p.inv_inertia.w);
+        s.disp = s.disp + dv * input.substep_dt;
+        reached = true;
     }
-    var dir = vec3<f32>(0.0, 1.0, 0.0);
-    if (dist > 0.0) {
-        dir = d / dist;
+    if (reached) {
+        set_state(i, s);
     }
-    let base = 1.0 - dist / radius;
-    var scale = 1.0; // pow(x, 0) is undefined at x = 0 in WGSL
-    if (input.reach.y == 1.0) {
-        scale = base;
-    } else if (input.reach.y != 0.0) {
-        scale = pow(base, input.reach.y);
-    }
-    let dv = dir * (input.centre.w * scale * p.inv_inertia.w);
-    s.disp = s.disp + dv * input.substep_dt;
-    set_state(i, s);
 }
 
 // Area (m^2) of the body's shape seen along the unit world direction u.
@@ -219,9 +243,10 @@ fn projected_area(p: BodyProps, rot: vec4<f32>, u: vec3<f32>) -> f32 {
     return 4.0 * (h.y * h.z * l.x + h.x * h.z * l.y + h.x * h.y * l.z);
 }
 
-// Quadratic drag of a uniform wind over input.reach.x seconds: the velocity
-// relative to the wind, u, decays as du/dt = -k |u| u with k = rho Cd A / 2m,
-// whose exact solution over t is u / (1 + k |u| t): never past the wind.
+// Quadratic drag of uniform winds, one per op in order, each over op.b.x
+// seconds: the velocity relative to the wind (op.a.xyz), u, decays as
+// du/dt = -k |u| u with k = rho Cd A / 2m (op.a.w = rho Cd / 2), whose exact
+// solution over t is u / (1 + k |u| t): never past the wind.
 @compute @workgroup_size(WORKGROUP)
 fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -234,15 +259,22 @@ fn wind(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var s = out_state(i);
     let h = input.substep_dt;
-    let v = s.disp / h;
-    let rel = input.centre.xyz - v; // wind relative to the body
-    let speed = length(rel);
-    if (speed == 0.0) {
-        return;
+    var blown = false;
+    for (var k = 0u; k < input.counts.y; k = k + 1u) {
+        let op = input_ops[k];
+        let v = s.disp / h;
+        let rel = op.a.xyz - v; // wind relative to the body
+        let speed = length(rel);
+        if (speed == 0.0) {
+            continue;
+        }
+        let drag = op.a.w * projected_area(p, s.rot, rel / speed) * p.inv_inertia.w;
+        let left = rel / (1.0 + drag * speed * op.b.x);
+        let dv = rel - left;
+        s.disp = s.disp + dv * h;
+        blown = true;
     }
-    let k = input.centre.w * projected_area(p, s.rot, rel / speed) * p.inv_inertia.w;
-    let left = rel / (1.0 + k * speed * input.reach.x);
-    let dv = rel - left;
-    s.disp = s.disp + dv * h;
-    set_state(i, s);
+    if (blown) {
+        set_state(i, s);
+    }
 }

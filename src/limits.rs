@@ -25,6 +25,41 @@ pub const MAX_TURN: f32 = 3.0;
 /// poses reads as speed (docs/limits.md has the measurements).
 pub const MIN_SUBSTEP: f32 = 1e-5;
 
+/// The longest step (s) a world takes (`settings.dt`, `World::step_with`):
+/// a step is one frame of a real-time simulation, and at 1 s unit cubes
+/// already rest 156 mm inside the ground (docs/limits.md).
+pub const MAX_DT: f32 = 1.0;
+
+/// The most steps a world counts: up to 2^53 the count and the time summed
+/// from it stay exact in f64, and nothing that counts steps overflows.
+pub const MAX_STEPS: u64 = 1 << 53;
+
+/// The latest simulated time (s) a world reaches, a track event comes at or
+/// a snapshot holds: 1e12 s (32 000 years) is 1e17 of the shortest steps,
+/// within a u64 step count with room to spare.
+pub const MAX_TIME: f64 = 1e12;
+
+/// The largest impulse (N s) an input gives a body or an explosion gives
+/// each body: it throws a thousand tonnes at `MAX_SPEED`. What a smaller one
+/// does depends on the mass, and a body it throws too fast is a fault.
+pub const MAX_IMPULSE: f32 = 1e10;
+
+/// The largest force (N) an input applies: over the longest step it gives
+/// `MAX_IMPULSE`.
+pub const MAX_FORCE: f32 = MAX_IMPULSE / MAX_DT;
+
+/// The densest air (kg/m^3) a wind blows with: denser than any matter
+/// (osmium is 22 590), so only a mistake is refused.
+pub const MAX_AIR_DENSITY: f32 = 1e5;
+
+/// The largest drag coefficient a wind takes: no shape drags more than
+/// about 2; 1e3 is only a bound on mistakes.
+pub const MAX_DRAG: f32 = 1e3;
+
+/// The nearest a camera may be to its target (m): nearer, the view's
+/// direction is lost to rounding and the frame comes out blank.
+pub const MIN_CAMERA_DISTANCE: f32 = 1e-3;
+
 /// Fastest speed (m/s) at which the solve pushes apart bodies that already
 /// overlapped at their previous poses (as Box2D's contact push speed);
 /// joints close an old gap no faster.

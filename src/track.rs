@@ -37,7 +37,9 @@
 //! f32) is step 60, not step 59.
 //!
 //! Loading checks what the file alone decides (JSON, unknown or missing
-//! fields, non-finite numbers, negative times, sizes); [`Track::check`]
+//! fields, non-finite numbers, negative times, times past
+//! `limits::MAX_TIME`, values beyond the limits the library's inputs are
+//! checked against, sizes); [`Track::check`]
 //! checks body indices against a scene's body count. Every error names the
 //! field as the scene loader does (`events[2].impulse.body: no body 40 (the
 //! scene has 12 bodies)`), with indices as in the file.
@@ -49,7 +51,9 @@ use serde::Deserialize;
 use crate::json::{path_string, Obj};
 use crate::load_error::FileKind;
 use crate::scene::{position_problem, speed_problem};
-use crate::world::input::{BodyInput, Point, Wind};
+use crate::world::input::{
+    air_density_problem, drag_problem, gust_problem, impulse_problem, radius_problem, strength_problem, BodyInput, Point, Wind,
+};
 use crate::{Error, World};
 
 /// A time less than this many steps below a step's start counts as that
@@ -247,8 +251,8 @@ impl Track {
     fn steps(e: &Event, dt: f32) -> (u64, u64) {
         let first = Track::step_of(e.t, dt);
         match &e.action {
-            Action::Wind { duration, .. } => (first, Track::step_of(e.t + *duration as f64, dt).max(first + 1)),
-            _ => (first, first + 1),
+            Action::Wind { duration, .. } => (first, Track::step_of(e.t + *duration as f64, dt).max(first.saturating_add(1))),
+            _ => (first, first.saturating_add(1)),
         }
     }
 
@@ -317,17 +321,24 @@ impl Track {
                 due.push((k, e));
             }
         }
-        // Runs of body inputs go as one batch; explosions between them keep their place.
+        // Runs of body inputs go as one batch, and runs of explosions as
+        // another, each keeping its place; the winds go together last.
         let mut batch: Vec<BodyInput> = Vec::new();
+        let mut blasts: Vec<([f32; 3], f32, f32, f32)> = Vec::new();
         for (_, e) in &due {
             match e.action.body_input() {
-                Some(input) => batch.push(input),
+                Some(input) => {
+                    if !blasts.is_empty() {
+                        world.explode_all(&std::mem::take(&mut blasts))?;
+                    }
+                    batch.push(input);
+                }
                 None => {
                     if !batch.is_empty() {
                         world.apply_inputs(&std::mem::take(&mut batch))?;
                     }
                     if let Action::Explode { centre, strength, radius, falloff } = e.action {
-                        world.explode(centre, strength, radius, falloff)?;
+                        blasts.push((centre, strength, radius, falloff));
                     }
                 }
             }
@@ -335,8 +346,12 @@ impl Track {
         if !batch.is_empty() {
             world.apply_inputs(&batch)?;
         }
-        for wind in &winds {
-            world.apply_wind(wind, dt)?;
+        if !blasts.is_empty() {
+            world.explode_all(&blasts)?;
+        }
+        if !winds.is_empty() {
+            let blowing: Vec<(Wind, f32)> = winds.iter().map(|&&w| (w, dt)).collect();
+            world.apply_winds(&blowing)?;
         }
         Ok(due.len() + winds.len())
     }
@@ -390,13 +405,21 @@ impl Track {
 // ---------------------------------------------------------------------------
 
 fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
+    use crate::limits::MAX_TIME;
     if !(e.t.is_finite() && e.t >= 0.0) {
         return Err(TrackError::invalid(format!("{path}.t"), format!("must be a finite time >= 0 s, got {}", e.t)));
+    }
+    if e.t > MAX_TIME {
+        return Err(TrackError::invalid(
+            format!("{path}.t"),
+            format!("is {:e} s, past {MAX_TIME:e} s, the latest time a world reaches", e.t),
+        ));
     }
     let at = |field: &str| format!("{path}.{}.{field}", e.action.name());
     match &e.action {
         Action::Impulse { impulse, point, .. } => {
             finite(impulse, &at("impulse"))?;
+            sane(impulse_problem(*impulse), &at("impulse"))?;
             if let Some(p) = point {
                 finite(p, &at("point"))?;
                 sane(position_problem(*p), &at("point"))?;
@@ -404,8 +427,11 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
         }
         Action::Explode { centre, strength, radius, falloff } => {
             finite(centre, &at("centre"))?;
+            sane(position_problem(*centre), &at("centre"))?;
             finite(&[*strength], &at("strength"))?;
+            sane(strength_problem(*strength), &at("strength"))?;
             at_least(*radius, &at("radius"), 0.0, false)?;
+            sane(radius_problem(*radius), &at("radius"))?;
             at_least(*falloff, &at("falloff"), 0.0, true)?;
         }
         Action::SetPose { position, orientation, .. } => {
@@ -438,8 +464,14 @@ fn validate_event(e: &Event, path: &str) -> Result<(), TrackError> {
             at_least(wind.air_density, &at("air_density"), 0.0, true)?;
             at_least(wind.drag, &at("drag"), 0.0, true)?;
             at_least(wind.gust, &at("gust"), 0.0, true)?;
+            sane(gust_problem(wind.velocity, wind.gust), &at("gust"))?;
+            sane(air_density_problem(wind.air_density), &at("air_density"))?;
+            sane(drag_problem(wind.drag), &at("drag"))?;
             at_least(wind.gust_period, &at("gust_period"), 0.0, false)?;
             at_least(*duration, &at("duration"), 0.0, false)?;
+            if *duration as f64 > MAX_TIME {
+                return Err(TrackError::invalid(at("duration"), format!("is {duration:e} s, past {MAX_TIME:e} s")));
+            }
         }
     }
     Ok(())

@@ -69,6 +69,9 @@ pub struct Gpu {
     /// upstream in gfx-rs/wgpu#9958). Threads that share a `Gpu` (the tests
     /// do) poll one at a time.
     polling: std::sync::Mutex<()>,
+    /// Which `Gpu` of this process it is: wgpu's devices of two instances
+    /// may compare equal (wgpu-core's ids are per instance).
+    id: u64,
     /// Every compute kernel and bind group layout made so far, kept for the
     /// device's life: a second world, or an edit, compiles nothing.
     kernels: std::sync::Mutex<Kernels>,
@@ -285,6 +288,8 @@ impl Gpu {
                 });
             }
         });
+        static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         Ok(Gpu {
             adapter,
             device,
@@ -295,6 +300,7 @@ impl Gpu {
             lost,
             polling: std::sync::Mutex::new(()),
             kernels: std::sync::Mutex::new(Kernels::default()),
+            id,
         })
     }
 
@@ -307,6 +313,11 @@ impl Gpu {
     #[doc(hidden)]
     pub fn loop_trips(&self) -> Option<u32> {
         self.info.name.contains("llvmpipe").then_some(65_000)
+    }
+
+    /// A number no other `Gpu` of this process has: whether two are the same.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// One line naming the adapter, its backend and driver.

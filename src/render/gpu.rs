@@ -398,11 +398,6 @@ impl Canvas {
         }
     }
 
-    /// Whether `device` is the one this canvas lives on.
-    pub(super) fn is_on(&self, device: &wgpu::Device) -> bool {
-        *device == self.device
-    }
-
     /// Rewrites the instance record in `slot` (a body's new colour).
     pub(super) fn write_body(&self, slot: u32, body: &RenderBody) {
         let offset = slot as u64 * std::mem::size_of::<RenderBody>() as u64;
@@ -502,7 +497,11 @@ impl Canvas {
         });
         gpu.wait()?;
         let gpu_err = |e: String| Error::Gpu(crate::gpu::GpuError::Runtime(e));
-        rx.recv().map_err(|e| gpu_err(e.to_string()))?.map_err(|e| gpu_err(e.to_string()))?;
+        // wgpu calls back while polling, so after the wait the answer is in
+        // (or never comes, on a broken device: do not block on it)
+        rx.recv_timeout(std::time::Duration::from_secs(1))
+            .map_err(|_| gpu_err("render: the image's readback never completed".into()))?
+            .map_err(|e| gpu_err(e.to_string()))?;
         let row = 4 * self.width as usize;
         let pixels = self.data.readback.get_mapped_range(..).map(|mapped| {
             // drop each row's padding up to COPY_BYTES_PER_ROW_ALIGNMENT

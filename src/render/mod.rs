@@ -65,6 +65,8 @@ pub struct RenderOptions {
 /// Draws a world's bodies into an image.
 pub struct Renderer {
     canvas: Canvas,
+    /// `Gpu::id` of the GPU it draws on.
+    gpu: u64,
     width: u32,
     height: u32,
     camera: CameraView,
@@ -122,6 +124,7 @@ impl Renderer {
         gpu.check()?;
         Ok(Renderer {
             canvas,
+            gpu: gpu.id(),
             width,
             height,
             camera,
@@ -157,13 +160,18 @@ impl Renderer {
     }
 
     /// Paints body `index` in `srgb` (each 0..1) instead of its own colour.
+    /// Refuses a body the scene lacks (naming `index`) and a channel outside
+    /// 0..1 or not a number (naming `srgb[k]`), changing nothing.
     pub fn set_body_color(&mut self, index: usize, srgb: [f32; 3]) -> Result<(), Error> {
         let slot = *self
             .slot_of_body
             .get(index)
-            .ok_or_else(|| Error::Input(format!("body {index}: the scene has {} bodies", self.body_count)))?;
+            .ok_or_else(|| Error::Input(format!("index: no body {index} (the scene has {} bodies)", self.body_count)))?;
+        if let Some(k) = srgb.iter().position(|c| !(0.0..=1.0).contains(c)) {
+            return Err(Error::Input(format!("srgb[{k}]: must be a number from 0 to 1, got {}", srgb[k])));
+        }
         let r = &mut self.instances[slot as usize];
-        r.color = srgb.map(|c| srgb_to_linear(c.clamp(0.0, 1.0)));
+        r.color = srgb.map(srgb_to_linear);
         self.canvas.write_body(slot, r);
         Ok(())
     }
@@ -194,8 +202,10 @@ impl Renderer {
                 self.body_count
             )));
         }
-        if !self.canvas.is_on(&world.gpu().device) {
-            return Err(Error::Input("render: the world lives on another device than the renderer".into()));
+        if world.gpu().id() != self.gpu {
+            return Err(Error::Input(
+                "render: the world runs on another Gpu than the renderer was made on (make the renderer with world.gpu())".into(),
+            ));
         }
         let state = (self.body_count > 0).then(|| world.current_state_buffer());
         self.canvas.draw(world.gpu(), state, self.has_ground, self.options.draw_joints)

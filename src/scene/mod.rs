@@ -372,5 +372,5 @@ use load::*;
 use validate::*;
 
 pub(crate) use validate::{
-    check_sink, dt_too_short, mass_problem, position_problem, speed_problem, spin_problem, validate_body, validate_joint,
+    check_sink, mass_problem, position_problem, speed_problem, spin_problem, step_dt_problem, validate_body, validate_joint,
 };

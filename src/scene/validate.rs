@@ -21,6 +21,9 @@ impl Scene {
         if self.ground.is_some() {
             check_sink(&self.settings, &self.bodies)?;
         }
+        if let Some(why) = dt_too_long(self.settings.dt) {
+            return Err(SceneError::invalid("settings.dt", why));
+        }
         if let Some(camera) = &self.camera {
             validate_camera(camera)?;
         }
@@ -71,6 +74,30 @@ pub(crate) fn dt_too_short(dt: f32, substeps: u32) -> Option<String> {
             crate::limits::MIN_SUBSTEP
         )
     })
+}
+
+/// Why a step of `dt` s is too long, if it is (`limits::MAX_DT`).
+pub(crate) fn dt_too_long(dt: f32) -> Option<String> {
+    use crate::limits::MAX_DT;
+    (dt > MAX_DT).then(|| format!("a step of {} s is longer than {MAX_DT} s, the longest a world takes", show(dt)))
+}
+
+/// Why a step of `dt` s is refused for `scene` (its settings with that dt),
+/// if it is: what the scene loader checks a `settings.dt` by.
+pub(crate) fn step_dt_problem(dt: f32, scene: &Scene) -> Option<String> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Some(format!("must be a positive finite number of seconds, got {}", show(dt)));
+    }
+    if let Some(why) = dt_too_short(dt, scene.settings.substeps) {
+        return Some(why);
+    }
+    if scene.ground.is_some() {
+        let settings = Settings { dt, ..scene.settings };
+        if let Err(SceneError::Invalid { message, .. }) = check_sink(&settings, &scene.bodies) {
+            return Some(message);
+        }
+    }
+    dt_too_long(dt)
 }
 
 /// Refuses a step so long that bodies would rest visibly inside the ground,
@@ -275,6 +302,20 @@ pub(super) fn validate_camera(camera: &Camera) -> Result<(), SceneError> {
         return Err(SceneError::invalid(
             "camera.target",
             format!("must differ from camera.position, both are {:?}", camera.position),
+        ));
+    }
+    // a camera beyond where any body may be sees nothing of the scene
+    for (field, p) in [("camera.position", camera.position), ("camera.target", camera.target)] {
+        if let Some(why) = position_problem(p) {
+            return Err(SceneError::invalid(field, why));
+        }
+    }
+    let gap = length(std::array::from_fn(|k| camera.target[k] - camera.position[k]));
+    let nearest = crate::limits::MIN_CAMERA_DISTANCE;
+    if gap < nearest as f64 {
+        return Err(SceneError::invalid(
+            "camera.target",
+            format!("lies {gap:.4e} m from camera.position; at least {nearest:e} m is needed to see along"),
         ));
     }
     let fov = camera.fov_y;

@@ -2,8 +2,9 @@
 //! poses, velocities, fixed/dynamic switches and radial explosions.
 //!
 //! Nothing is read back. Every call validates its arguments on the host
-//! (a bad body index or a non-finite number is an [`Error::Input`] naming
-//! the argument), then writes a small list of ops and dispatches a kernel of
+//! (a bad body index, a non-finite number or one beyond the limits the
+//! scene loader uses, `crate::limits`, is an [`Error::Input`] naming the
+//! argument, and nothing is applied), then writes a small list of ops and dispatches a kernel of
 //! `shaders/input.wgsl` that rewrites the affected bodies' slots of the
 //! current state buffer in place. The queue orders it after the steps
 //! already submitted and before the next one, so the host never waits.
@@ -16,7 +17,9 @@
 //! until every submitted step has run. A batch of inputs ([`World::apply_inputs`])
 //! is one dispatch: ops are sorted by body (in call order within a body) and
 //! one thread applies each body's run of ops in order, so any number of
-//! inputs to the same body compose without races.
+//! inputs to the same body compose without races. Explosions and winds
+//! given together go the same way ([`World::apply_winds`]): one thread per
+//! body applies each in order.
 //!
 //! Velocity changes rewrite the previous pose: with h the substep that
 //! produced the current pose, v = disp / h (disp = pos - prev_pos, kept
@@ -93,8 +96,10 @@ pub enum BodyInput {
     /// and the inertia of a solid of its shape, or with `mass: None` the mass
     /// it had when it was made fixed; a body loaded as fixed then gets the
     /// mass its scene gave it (its `mass`, or its density times its volume;
-    /// 1 kg where that mass is one its shape cannot move with). A mass whose
-    /// inverse mass or inertia f32 cannot hold is refused, as a scene's is.
+    /// 1 kg where that mass is one its shape cannot move with). On a body
+    /// already dynamic, `mass` sets its mass and inertia, keeping its
+    /// velocities (`None`: nothing changes). A mass whose inverse mass or
+    /// inertia f32 cannot hold is refused, as a scene's is.
     Fixed { body: usize, fixed: bool, mass: Option<f32> },
 }
 
@@ -154,18 +159,23 @@ impl Wind {
         self.velocity.map(|v| (v as f64 * scale) as f32)
     }
 
-    fn validate(&self) -> Result<(), Error> {
-        check_finite("wind.velocity", &self.velocity)?;
+    fn validate(&self, at: &str) -> Result<(), Error> {
+        let name = |field: &str| format!("{at}{field}");
+        check_finite(&name("velocity"), &self.velocity)?;
         // the drag pulls a body toward the wind's velocity
-        check_sane("wind.velocity", crate::scene::speed_problem(self.velocity))?;
-        for (name, v) in [("wind.air_density", self.air_density), ("wind.drag", self.drag), ("wind.gust", self.gust)] {
+        check_sane(&name("velocity"), crate::scene::speed_problem(self.velocity))?;
+        for (field, v) in [("air_density", self.air_density), ("drag", self.drag), ("gust", self.gust)] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::Input(format!("{name}: must be a finite number >= 0, got {v}")));
+                return Err(Error::Input(format!("{}: must be a finite number >= 0, got {v}", name(field))));
             }
         }
+        check_sane(&name("gust"), gust_problem(self.velocity, self.gust))?;
+        check_sane(&name("air_density"), air_density_problem(self.air_density))?;
+        check_sane(&name("drag"), drag_problem(self.drag))?;
         if !(self.gust_period.is_finite() && self.gust_period > 0.0) {
             return Err(Error::Input(format!(
-                "wind.gust_period: must be a positive finite number of seconds, got {}",
+                "{}: must be a positive finite number of seconds, got {}",
+                name("gust_period"),
                 self.gust_period
             )));
         }
@@ -173,7 +183,7 @@ impl Wind {
     }
 }
 
-/// Host twin of `InputHeader` in shaders/input.wgsl (64 bytes).
+/// Host twin of `InputHeader` in shaders/input.wgsl (32 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct InputHeader {
@@ -181,8 +191,6 @@ pub struct InputHeader {
     pub gravity: [f32; 3],
     /// h, the last substep (s).
     pub substep_dt: f32,
-    pub centre: [f32; 4],
-    pub reach: [f32; 4],
     pub counts: [u32; 4],
 }
 
@@ -251,6 +259,97 @@ fn check_sane(name: &str, problem: Option<String>) -> Result<(), Error> {
     problem.map_or(Ok(()), |why| Err(Error::Input(format!("{name}: {why}"))))
 }
 
+fn length(v: [f32; 3]) -> f64 {
+    v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt()
+}
+
+/// Why an impulse `j` (N s) is absurd, if it is (`limits::MAX_IMPULSE`).
+pub(crate) fn impulse_problem(j: [f32; 3]) -> Option<String> {
+    use crate::limits::MAX_IMPULSE;
+    let size = length(j);
+    (size > MAX_IMPULSE as f64).then(|| format!("is {size:.4e} N s; at most {MAX_IMPULSE:e} N s is sane"))
+}
+
+/// Why an explosion's `strength` (N s, either sign) is absurd, if it is.
+pub(crate) fn strength_problem(strength: f32) -> Option<String> {
+    impulse_problem([strength, 0.0, 0.0])
+}
+
+/// Why a force `f` (N) is absurd, if it is (`limits::MAX_FORCE`).
+pub(crate) fn force_problem(f: [f32; 3]) -> Option<String> {
+    use crate::limits::MAX_FORCE;
+    let size = length(f);
+    (size > MAX_FORCE as f64).then(|| format!("is {size:.4e} N; at most {MAX_FORCE:e} N is sane"))
+}
+
+/// Why an explosion's `radius` (m) is absurd, if it is (`limits::MAX_DISTANCE`).
+pub(crate) fn radius_problem(radius: f32) -> Option<String> {
+    use crate::limits::MAX_DISTANCE;
+    (radius > MAX_DISTANCE).then(|| format!("is {radius:e} m; at most {MAX_DISTANCE:e} m is sane"))
+}
+
+/// Why an input acting `duration` s before the next step is absurd, if it is:
+/// longer than the longest step (`limits::MAX_DT`).
+pub(crate) fn duration_problem(duration: f32) -> Option<String> {
+    use crate::limits::MAX_DT;
+    (duration > MAX_DT).then(|| format!("is {duration:e} s, longer than the longest step ({MAX_DT} s)"))
+}
+
+/// Why gusts of strength `gust` on a wind of `velocity` are absurd, if they
+/// are: their peak, |velocity| (1 + gust), past `limits::MAX_SPEED`.
+pub(crate) fn gust_problem(velocity: [f32; 3], gust: f32) -> Option<String> {
+    use crate::limits::MAX_SPEED;
+    let peak = length(velocity) * (1.0 + gust as f64);
+    (peak > MAX_SPEED as f64)
+        .then(|| format!("gusts of {gust:e} blow the wind at up to {peak:.4e} m/s; at most {MAX_SPEED:e} m/s is sane"))
+}
+
+/// Why a wind's air density (kg/m^3) is absurd, if it is.
+pub(crate) fn air_density_problem(rho: f32) -> Option<String> {
+    use crate::limits::MAX_AIR_DENSITY;
+    (rho > MAX_AIR_DENSITY).then(|| format!("is {rho:e} kg/m^3; at most {MAX_AIR_DENSITY:e} kg/m^3 is sane"))
+}
+
+/// Why a wind's drag coefficient is absurd, if it is.
+pub(crate) fn drag_problem(drag: f32) -> Option<String> {
+    use crate::limits::MAX_DRAG;
+    (drag > MAX_DRAG).then(|| format!("is {drag:e}; at most {MAX_DRAG:e} is sane"))
+}
+
+/// Refuses a `duration` (s) that is not finite, negative or too long.
+fn check_duration(name: &str, duration: f32) -> Result<(), Error> {
+    if !(duration.is_finite() && duration >= 0.0) {
+        return Err(Error::Input(format!("{name}: must be a finite number of seconds >= 0, got {duration}")));
+    }
+    check_sane(name, duration_problem(duration))
+}
+
+/// The op of an explosion (see `World::explode`), its arguments checked and
+/// named after `at` (`explosions[2].`, or nothing).
+fn explosion_op(centre: [f32; 3], strength: f32, radius: f32, falloff: f32, at: &str) -> Result<InputOp, Error> {
+    let name = |field: &str| format!("{at}{field}");
+    check_finite(&name("centre"), &centre)?;
+    check_sane(&name("centre"), crate::scene::position_problem(centre))?;
+    check_finite(&name("strength"), &[strength])?;
+    check_sane(&name("strength"), strength_problem(strength))?;
+    if !(radius.is_finite() && radius > 0.0) {
+        return Err(Error::Input(format!("{}: must be a positive finite number of metres, got {radius}", name("radius"))));
+    }
+    check_sane(&name("radius"), radius_problem(radius))?;
+    if !(falloff.is_finite() && falloff >= 0.0) {
+        return Err(Error::Input(format!("{}: must be a finite exponent >= 0, got {falloff}", name("falloff"))));
+    }
+    Ok(InputOp { a: [centre[0], centre[1], centre[2], strength], b: [radius, falloff, 0.0, 0.0], ..Default::default() })
+}
+
+/// Inverse inertia (xyz) and inverse mass (w) of a dynamic body of `shape`
+/// and `mass`, worked out as the scene's bodies' are.
+fn inverse_props(shape: &crate::Shape, mass: f32) -> [f32; 4] {
+    let body = crate::Body { mass, fixed: false, ..crate::Body::new(shape.clone(), [0.0; 3]) };
+    let ii = body.inverse_inertia();
+    [ii[0], ii[1], ii[2], body.inverse_mass()]
+}
+
 impl World {
     /// Applies an impulse (N s) at `point` (world coordinates; `None`: the
     /// centre of mass) before the next step: the velocity changes by J / m,
@@ -272,9 +371,8 @@ impl World {
     /// step's dt).
     pub fn apply_force(&mut self, body: usize, force: [f32; 3], point: Option<[f32; 3]>, duration: f32) -> Result<(), Error> {
         check_finite("force", &force)?;
-        if !(duration.is_finite() && duration >= 0.0) {
-            return Err(Error::Input(format!("duration: must be a finite number of seconds >= 0, got {duration}")));
-        }
+        check_sane("force", force_problem(force))?;
+        check_duration("duration", duration)?;
         self.apply_impulse(body, force.map(|f| f * duration), point)
     }
 
@@ -303,7 +401,8 @@ impl World {
     }
 
     /// Makes a body dynamic, at rest, with `mass` (kg) and the inertia of a
-    /// solid of its shape.
+    /// solid of its shape; on a body already dynamic, sets its mass and
+    /// inertia and keeps its velocities.
     pub fn set_dynamic(&mut self, body: usize, mass: f32) -> Result<(), Error> {
         self.input_ops(&[BodyInput::Fixed { body, fixed: false, mass: Some(mass) }], "")
     }
@@ -324,20 +423,19 @@ impl World {
     /// quadratic. A negative strength pulls inward. Bodies outside the radius
     /// are not touched.
     pub fn explode(&mut self, centre: [f32; 3], strength: f32, radius: f32, falloff: f32) -> Result<(), Error> {
-        check_finite("centre", &centre)?;
-        check_finite("strength", &[strength])?;
-        if !(radius.is_finite() && radius > 0.0) {
-            return Err(Error::Input(format!("radius: must be a positive finite number of metres, got {radius}")));
+        let op = explosion_op(centre, strength, radius, falloff, "")?;
+        self.dispatch_list(&[op], EXPLODE)
+    }
+
+    /// Explosions as [`World::explode`] takes them (centre, strength,
+    /// radius, falloff), applied in order in one dispatch; nothing is
+    /// applied if any is bad, and the error names it (`explosions[2].radius`).
+    pub(crate) fn explode_all(&mut self, explosions: &[([f32; 3], f32, f32, f32)]) -> Result<(), Error> {
+        let mut ops = Vec::with_capacity(explosions.len());
+        for (k, &(centre, strength, radius, falloff)) in explosions.iter().enumerate() {
+            ops.push(explosion_op(centre, strength, radius, falloff, &format!("explosions[{k}]."))?);
         }
-        if !(falloff.is_finite() && falloff >= 0.0) {
-            return Err(Error::Input(format!("falloff: must be a finite exponent >= 0, got {falloff}")));
-        }
-        let header = InputHeader {
-            centre: [centre[0], centre[1], centre[2], strength],
-            reach: [radius, falloff, 0.0, 0.0],
-            ..self.input_header(0)
-        };
-        self.dispatch_input(&header, &[], EXPLODE)
+        self.dispatch_list(&ops, EXPLODE)
     }
 
     /// Blows `wind` on every dynamic body for `duration` seconds, as an
@@ -347,22 +445,51 @@ impl World {
     /// body past the wind's own velocity. This is the between-steps form; a
     /// wind that acts within every substep needs `integrate` to add it.
     pub fn apply_wind(&mut self, wind: &Wind, duration: f32) -> Result<(), Error> {
-        wind.validate()?;
-        if !(duration.is_finite() && duration >= 0.0) {
-            return Err(Error::Input(format!("duration: must be a finite number of seconds >= 0, got {duration}")));
+        wind.validate("wind.")?;
+        check_duration("duration", duration)?;
+        if duration == 0.0 {
+            return Ok(()); // blows nothing
         }
+        let op = self.wind_op(wind, duration);
+        self.dispatch_list(&[op], WIND)
+    }
+
+    /// Blows each `(wind, duration)` in order, as [`World::apply_wind`]
+    /// does one, in one dispatch (a batch of `INPUT_BATCH` at a time);
+    /// nothing is applied if any is bad, and the error names it
+    /// (`winds[2].wind.gust`, `winds[2].duration`).
+    pub fn apply_winds(&mut self, winds: &[(Wind, f32)]) -> Result<(), Error> {
+        for (k, (wind, duration)) in winds.iter().enumerate() {
+            wind.validate(&format!("winds[{k}].wind."))?;
+            check_duration(&format!("winds[{k}].duration"), *duration)?;
+        }
+        // a wind of no duration blows nothing (and a drag too large for f32
+        // times 0 would be NaN)
+        let ops: Vec<InputOp> =
+            winds.iter().filter(|(_, d)| *d > 0.0).map(|(wind, duration)| self.wind_op(wind, *duration)).collect();
+        self.dispatch_list(&ops, WIND)
+    }
+
+    /// The op of a wind at the world's current time (a duration of 0 blows nothing).
+    fn wind_op(&self, wind: &Wind, duration: f32) -> InputOp {
         let u = wind.at(self.time);
-        let header = InputHeader {
-            centre: [u[0], u[1], u[2], 0.5 * wind.air_density * wind.drag],
-            reach: [duration, 0.0, 0.0, 0.0],
-            ..self.input_header(0)
-        };
-        self.dispatch_input(&header, &[], WIND)
+        InputOp { a: [u[0], u[1], u[2], 0.5 * wind.air_density * wind.drag], b: [duration, 0.0, 0.0, 0.0], ..Default::default() }
+    }
+
+    /// Dispatches `kernel` (explode or wind) over a list of its ops, in
+    /// batches of at most `INPUT_BATCH`, each one loop of every body's
+    /// thread (lavapipe ends an invocation's loops at 65535 trips).
+    fn dispatch_list(&mut self, ops: &[InputOp], kernel: usize) -> Result<(), Error> {
+        for batch in ops.chunks(INPUT_BATCH) {
+            let header = self.input_header(batch.len());
+            self.dispatch_input(&header, batch, kernel)?;
+        }
+        Ok(())
     }
 
     fn input_header(&self, ops: usize) -> InputHeader {
         let g = self.settings.gravity;
-        InputHeader { gravity: g, substep_dt: self.dt_prev, counts: [self.body_count, ops as u32, 0, 0], ..Default::default() }
+        InputHeader { gravity: g, substep_dt: self.dt_prev, counts: [self.body_count, ops as u32, 0, 0] }
     }
 
     /// Validates `inputs` (naming bad ones after `list`, or plainly when it
@@ -379,6 +506,7 @@ impl World {
             match *input {
                 BodyInput::Impulse { impulse, point, .. } => {
                     check_finite(&at("impulse"), &impulse)?;
+                    check_sane(&at("impulse"), impulse_problem(impulse))?;
                     op.kind = INPUT_IMPULSE;
                     op.a = [impulse[0], impulse[1], impulse[2], 0.0];
                     let (mode, p) = match point {
@@ -417,16 +545,20 @@ impl World {
                     op.b = [angular[0], angular[1], angular[2], 0.0];
                 }
                 BodyInput::Fixed { fixed, mass, .. } => {
+                    let scene = &self.scene.bodies[body];
                     if let Some(m) = mass {
                         // what the scene's own mass is checked by, for the body's shape
-                        check_sane(&at("mass"), crate::scene::mass_problem(&self.scene.bodies[body].shape, m))?;
+                        check_sane(&at("mass"), crate::scene::mass_problem(&scene.shape, m))?;
                     }
                     // for a body loaded fixed (no mass kept on the GPU), the
                     // mass its scene gave it, where its shape can move with it
-                    let scene = &self.scene.bodies[body];
                     let loaded = if crate::scene::mass_problem(&scene.shape, scene.mass).is_none() { scene.mass } else { 1.0 };
                     op.kind = INPUT_FIXED;
                     op.a = [fixed as u32 as f32, mass.unwrap_or(0.0), loaded, 0.0];
+                    // worked out here as the scene's are, so that a body made
+                    // fixed and dynamic again gets its own properties back
+                    op.b = mass.map_or([0.0; 4], |m| inverse_props(&scene.shape, m));
+                    op.c = inverse_props(&scene.shape, loaded);
                 }
             }
             ops.push(op);
@@ -451,7 +583,7 @@ impl World {
     }
 
     fn dispatch_input(&mut self, header: &InputHeader, ops: &[InputOp], kernel: usize) -> Result<(), Error> {
-        if self.body_count == 0 {
+        if self.body_count == 0 || ops.is_empty() {
             return Ok(());
         }
         self.ensure_input_gpu(ops.len());

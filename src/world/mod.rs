@@ -195,9 +195,12 @@ impl World {
         self.at_rest
     }
 
-    /// Takes `steps` steps of `settings.dt`.
+    /// Takes `steps` steps of `settings.dt`. Refuses a count that would take
+    /// the world past `limits::MAX_STEPS` steps or `limits::MAX_TIME`
+    /// seconds, before taking any.
     pub fn step(&mut self, steps: u64) -> Result<(), Error> {
         let dt = self.settings.dt;
+        self.check_steps("steps", steps, steps as f64 * dt as f64)?;
         let mut left = steps;
         while left > 0 {
             if self.at_rest {
@@ -219,14 +222,17 @@ impl World {
     /// call after it happened.
     pub fn step_with(&mut self, dts: &[f32]) -> Result<(), Error> {
         self.gpu.check()?;
+        // each dt as the scene loader checks a scene's (a run of equal ones once:
+        // the check walks the bodies)
         for (k, &dt) in dts.iter().enumerate() {
-            if !(dt.is_finite() && dt > 0.0) {
-                return Err(Error::Input(format!("dt[{k}]: must be a positive finite number of seconds, got {dt}")));
+            if k > 0 && dt.to_bits() == dts[k - 1].to_bits() {
+                continue;
             }
-            if let Some(why) = crate::scene::dt_too_short(dt, self.settings.substeps) {
-                return Err(Error::Input(format!("dt[{k}]: {why}")));
+            if let Some(why) = crate::scene::step_dt_problem(dt, &self.scene) {
+                return Err(Error::Input(format!("dts[{k}]: {why}")));
             }
         }
+        self.check_steps("dts", dts.len() as u64, dts.iter().map(|&d| d as f64).sum())?;
         let substeps = self.settings.substeps as usize;
         for chunk in dts.chunks(self.steps_per_batch()) {
             if self.at_rest {
@@ -248,6 +254,27 @@ impl World {
                 self.restore_batch_start(start);
                 self.encode_and_submit(chunk, substeps);
             }
+        }
+        Ok(())
+    }
+
+    /// Refuses `steps` more steps lasting `seconds` in all where they would
+    /// take the step count past `MAX_STEPS` or the time past `MAX_TIME`
+    /// (`name` is the argument that gave them).
+    fn check_steps(&self, name: &str, steps: u64, seconds: f64) -> Result<(), Error> {
+        use crate::limits::{MAX_STEPS, MAX_TIME};
+        if steps > MAX_STEPS - self.step.min(MAX_STEPS) {
+            return Err(Error::Input(format!(
+                "{name}: {steps} more steps would take the world ({} steps so far) past {MAX_STEPS}, the most it counts",
+                self.step
+            )));
+        }
+        if self.time + seconds > MAX_TIME {
+            return Err(Error::Input(format!(
+                "{name}: {steps} more steps ({seconds:e} s) would take the world ({:e} s so far) past {MAX_TIME:e} s, the \
+                 latest it reaches",
+                self.time
+            )));
         }
         Ok(())
     }
@@ -282,7 +309,7 @@ impl World {
         self.note_wants([0, 0], usize::try_from(steps).unwrap_or(usize::MAX));
         self.shrink_pools()?;
         self.dt_prev = dt / self.settings.substeps as f32;
-        self.step = self.step.saturating_add(steps);
+        self.step += steps;
         self.time += steps as f64 * dt as f64;
         Ok(())
     }

@@ -22,6 +22,15 @@
 //! data (settings, ground, grid, the bodies' shapes, masses and materials,
 //! and the joints), and restoring it into another scene is refused.
 //!
+//! A snapshot is checked as a scene is before anything of it is restored
+//! (`Snapshot::problem`): every number finite, every quaternion of unit
+//! length within `NORM_TOLERANCE`, positions, speeds and spins within
+//! `SNAPSHOT_MARGIN` times the limits the step stops a body at, the last
+//! substep within the limits a step's length is held to, the step count and
+//! time within `limits::MAX_STEPS` and `limits::MAX_TIME`. Reading a file
+//! reads its header first and then no more than the header says the file
+//! holds, so a huge or endless file is refused at once.
+//!
 //! # File format (version 3, little-endian)
 //!
 //! | offset | size | field |
@@ -65,6 +74,15 @@ const VERSION_PREV_POS: u32 = 1;
 const HEADER: usize = 48;
 const TRAILER: usize = 8;
 const POSE: usize = std::mem::size_of::<BodyState>();
+/// The largest snapshot file: one of the most bodies any world holds.
+const MAX_BYTES: u64 = (HEADER + TRAILER) as u64 + (POSE as u64 + 1) * crate::scenes::MAX_BODIES;
+/// How far from 1 a quaternion's length may be: the GPU keeps them unit to
+/// f32 rounding, far within it.
+const NORM_TOLERANCE: f64 = 1e-3;
+/// A body's position, speed and spin may be this many times the limits the
+/// step stops a body at: the solve may push a body a little past them after
+/// the step's check (the next step stops it), but no world holds more.
+const SNAPSHOT_MARGIN: f64 = 2.0;
 
 /// The dynamic state of a world at one step.
 #[derive(Clone, Debug, PartialEq)]
@@ -168,6 +186,9 @@ impl Snapshot {
                 bytes.len()
             ));
         }
+        if n as u64 > crate::scenes::MAX_BODIES {
+            return Err(format!("snapshot of {n} bodies: no world holds more than {}", crate::scenes::MAX_BODIES));
+        }
         let body_end = bytes.len() - TRAILER;
         let stored = u64_at(body_end);
         let actual = fnv1a(FNV_OFFSET, &bytes[..body_end]);
@@ -177,12 +198,6 @@ impl Snapshot {
         let step = u64_at(16);
         let time = f64::from_bits(u64_at(24));
         let dt_prev = f32_at(32);
-        if !(time.is_finite() && time >= 0.0) {
-            return Err(format!("snapshot time {time} is not a non-negative finite number"));
-        }
-        if !(dt_prev.is_finite() && dt_prev > 0.0) {
-            return Err(format!("snapshot dt_prev {dt_prev} is not a positive finite number"));
-        }
         let scene_hash = u64_at(40);
         let states = (0..n)
             .map(|i| {
@@ -213,10 +228,67 @@ impl Snapshot {
             })
             .collect();
         let woken = if version == VERSION { bytes[HEADER + n * POSE..HEADER + n * (POSE + 1)].to_vec() } else { vec![0; n] };
-        if let Some(i) = woken.iter().position(|&w| u32::from(w) > WOKEN_NOW | WOKEN_LAST) {
-            return Err(format!("snapshot body {i}: wake flags {} are not 0 to 3", woken[i]));
+        let snapshot = Snapshot { step, time, dt_prev, scene_hash, states, woken };
+        match snapshot.problem() {
+            Some(why) => Err(why),
+            None => Ok(snapshot),
         }
-        Ok(Snapshot { step, time, dt_prev, scene_hash, states, woken })
+    }
+
+    /// What is absurd in the snapshot, if anything (see the module
+    /// documentation): what a world cannot hold, whatever its scene.
+    fn problem(&self) -> Option<String> {
+        use crate::limits::{MAX_DISTANCE, MAX_DT, MAX_SPEED, MAX_SPIN, MAX_STEPS, MAX_TIME, MIN_SUBSTEP};
+        if self.step > MAX_STEPS {
+            return Some(format!("snapshot step {} is past {MAX_STEPS}, the most steps a world counts", self.step));
+        }
+        let time = self.time;
+        if !(time.is_finite() && (0.0..=MAX_TIME).contains(&time)) {
+            return Some(format!("snapshot time {time} is not a finite number of seconds from 0 to {MAX_TIME:e}"));
+        }
+        let h = self.dt_prev;
+        // the substep of the shortest and the longest step a world takes
+        let shortest = MIN_SUBSTEP as f64 * (1.0 - 1e-6);
+        if !(h.is_finite() && h as f64 >= shortest && h <= MAX_DT) {
+            return Some(format!("snapshot dt_prev {h} is not a substep a world takes (from {MIN_SUBSTEP:e} to {MAX_DT} s)"));
+        }
+        let margin = SNAPSHOT_MARGIN;
+        let length = |v: &[f32]| v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+        for (i, (s, &w)) in self.states.iter().zip(&self.woken).enumerate() {
+            let at = |field: &str| format!("snapshot body {i}: {field}");
+            let words = [&s.pos[..], &s.disp[..], &s.rot[..], &s.prev_rot[..], &[s.rest_time][..]];
+            if words.iter().any(|v| v.iter().any(|x| !x.is_finite())) {
+                return Some(at("a non-finite number in its state"));
+            }
+            if s.rest_time < 0.0 {
+                return Some(at(&format!("time at rest {} is negative", s.rest_time)));
+            }
+            let distance = length(&s.pos);
+            if distance > margin * MAX_DISTANCE as f64 {
+                return Some(at(&format!("lies {distance:.4e} m from the origin, beyond {MAX_DISTANCE:e} m")));
+            }
+            for (name, q) in [("orientation", s.rot), ("previous orientation", s.prev_rot)] {
+                let norm = length(&q);
+                if (norm - 1.0).abs() > NORM_TOLERANCE {
+                    return Some(at(&format!("{name} {q:?} is not a unit quaternion (length {norm:.6})")));
+                }
+            }
+            let speed = length(&s.disp) / h as f64;
+            if speed > margin * MAX_SPEED as f64 {
+                return Some(at(&format!("moves at {speed:.4e} m/s, beyond {MAX_SPEED:e} m/s")));
+            }
+            // the turn over the last substep, from the pose pair
+            let dot = s.rot.iter().zip(&s.prev_rot).map(|(&a, &b)| a as f64 * b as f64).sum::<f64>();
+            let turn = 2.0 * (dot.abs() / (length(&s.rot) * length(&s.prev_rot))).min(1.0).acos();
+            let spin = turn / h as f64;
+            if spin > margin * MAX_SPIN as f64 {
+                return Some(at(&format!("spins at {spin:.4e} rad/s, beyond {MAX_SPIN:e} rad/s")));
+            }
+            if u32::from(w) > WOKEN_NOW | WOKEN_LAST {
+                return Some(at(&format!("wake flags {w} are not 0 to 3")));
+            }
+        }
+        None
     }
 
     /// Writes the snapshot to `path`.
@@ -227,10 +299,60 @@ impl Snapshot {
 
     /// Reads a snapshot written by `write`; a file that is not one, or is
     /// truncated or corrupt, is refused with the reason.
+    /// Reads no more than the header says the file holds, and refuses a
+    /// file larger than a snapshot of the most bodies any world holds before
+    /// reading it.
     pub fn read(path: impl AsRef<Path>) -> Result<Snapshot, Error> {
+        use std::io::Read;
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.display().to_string(), source })?;
-        Snapshot::from_bytes(&bytes).map_err(|why| Error::Input(format!("{}: {why}", path.display())))
+        let io = |source| Error::Io { path: path.display().to_string(), source };
+        let refuse = |why: String| Error::Input(format!("{}: {why}", path.display()));
+        let file = std::fs::File::open(path).map_err(io)?;
+        // a regular file's length is known before reading it (a device or a
+        // pipe's is not: those are read with the bound alone)
+        let known = file.metadata().ok().filter(|m| m.is_file()).map(|m| m.len());
+        if let Some(len) = known.filter(|&len| len > MAX_BYTES) {
+            return Err(refuse(format!(
+                "{len} bytes is larger than a snapshot of the most bodies any world holds ({MAX_BYTES} bytes)"
+            )));
+        }
+        let mut reader = file.take(MAX_BYTES + 1);
+        let mut bytes = Vec::with_capacity(HEADER);
+        (&mut reader).take(HEADER as u64).read_to_end(&mut bytes).map_err(io)?;
+        // the header says how long the file is: read one byte more, to tell padding
+        let (n, expected) = Snapshot::expected_len(&bytes).map_err(refuse)?;
+        if expected > MAX_BYTES {
+            return Err(refuse(format!(
+                "snapshot of {n} bodies should be {expected} bytes, more than a snapshot of the most bodies any world \
+                 holds ({MAX_BYTES} bytes)"
+            )));
+        }
+        if let Some(len) = known.filter(|&len| len != expected) {
+            return Err(refuse(format!("snapshot of {n} bodies should be {expected} bytes but is {len} (truncated or padded)")));
+        }
+        bytes.reserve((expected as usize).saturating_sub(HEADER));
+        reader.take(expected + 1 - HEADER as u64).read_to_end(&mut bytes).map_err(io)?;
+        Snapshot::from_bytes(&bytes).map_err(refuse)
+    }
+
+    /// The body count and the length of the file whose first bytes are
+    /// `header`, from its version, or why those are not a snapshot's.
+    fn expected_len(header: &[u8]) -> Result<(u64, u64), String> {
+        if header.len() < MAGIC.len() || &header[..MAGIC.len()] != MAGIC {
+            return Err("not a verlet snapshot (no VRLTSNAP header)".into());
+        }
+        if header.len() < HEADER {
+            return Err(format!("truncated snapshot: {} bytes, a header alone takes {}", header.len(), HEADER + TRAILER));
+        }
+        let version = u32::from_le_bytes(header[8..12].try_into().expect("4 bytes"));
+        let n = u32::from_le_bytes(header[12..16].try_into().expect("4 bytes")) as u64;
+        if !(VERSION_PREV_POS..=VERSION).contains(&version) {
+            return Err(format!(
+                "snapshot version {version} is not supported (this build reads versions {VERSION_PREV_POS} to {VERSION})"
+            ));
+        }
+        let per_body = if version == VERSION { POSE + 1 } else { POSE } as u64;
+        Ok((n, (HEADER + TRAILER) as u64 + n * per_body))
     }
 }
 
@@ -251,6 +373,9 @@ impl World {
     /// taken from a world of the same scene; stepping on from here gives
     /// bit for bit what the original world gave.
     pub fn restore(&mut self, snapshot: &Snapshot) -> Result<(), Error> {
+        if let Some(why) = snapshot.problem() {
+            return Err(Error::Input(why));
+        }
         if snapshot.states.len() != self.body_count as usize {
             return Err(Error::Input(format!(
                 "snapshot has {} bodies but this world has {}: it belongs to another scene",
@@ -264,9 +389,6 @@ impl World {
                 "snapshot belongs to another scene (scene hash {:016x}, this world's {hash:016x})",
                 snapshot.scene_hash
             )));
-        }
-        if !(snapshot.dt_prev.is_finite() && snapshot.dt_prev > 0.0) {
-            return Err(Error::Input(format!("snapshot dt_prev {} is not a positive finite number", snapshot.dt_prev)));
         }
         if !snapshot.states.is_empty() {
             // the wake flags as the pose's bit (version 2 and older, and

@@ -76,7 +76,7 @@ fn a_step_too_short_for_the_poses_is_refused_and_the_shortest_rests() {
     world.step(30).unwrap();
     let before = raw(&world);
     let err = world.step_with(&[1.0 / 60.0, 1e-9]).unwrap_err();
-    assert!(matches!(&err, Error::Input(m) if m.starts_with("dt[1]: ") && m.contains("shorter than 1e-5 s")), "{err}");
+    assert!(matches!(&err, Error::Input(m) if m.starts_with("dts[1]: ") && m.contains("shorter than 1e-5 s")), "{err}");
     assert_eq!(world.step_count(), 30, "nothing taken");
     assert_eq!(raw(&world), before, "the poses as they were");
     let shortest = verlet::limits::MIN_SUBSTEP * world.settings().substeps as f32;

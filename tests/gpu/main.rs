@@ -6,6 +6,7 @@
 mod common;
 
 mod api_edits;
+mod api_hostile;
 mod capacity;
 mod collide_reference;
 mod determinism;
