@@ -42,6 +42,9 @@ override LOOP_TRIPS: u32 = 0xffffffffu;
 // ball joints: body i's ends are joint_refs[joint_start[i] .. joint_start[i + 1]]
 @group(0) @binding(13) var<storage, read> joint_start: array<u32>;              // body_count + 1
 @group(0) @binding(14) var<storage, read> joint_refs: array<JointRef>;          // 2 per joint
+// each joint island's least rest time (its bits) and whether it is held, two
+// words an island, gathered by joint_rest_gather with integer atomics
+@group(0) @binding(23) var<storage, read_write> island_rest: array<atomic<u32>>; // 2 x island count
 
 // The busiest buffers are bound as vec4 words (the same bytes as their
 // structs; tests/gpu/layouts.rs checks each pair) and read and written

@@ -315,42 +315,92 @@ fn close_joint(j: JointRef) {
     }
 }
 
-// Pass "joint_rest", once a substep after its first solve, in place: an
-// island sleeps and wakes as one. Every body takes the island's least rest
-// time, or none if nothing holds the island up (no contact presses it, no
-// joint to the world or a fixed body). One invocation per island: 2n loop
-// trips for n joints, within LOOP_TRIPS (World::with_gpu refuses more).
+// Passes "joint_rest_clear", "joint_rest_gather" and "joint_rest", once a
+// substep after its first solve, where bodies sleep: an island sleeps and
+// wakes as one. Every body takes the island's least rest time, or none if
+// nothing holds the island up (no contact presses it, no joint to the world
+// or a fixed body). The island's least time and whether it is held are
+// gathered over its joints, one invocation each, with integer atomics (a
+// minimum and an or: the same result in any order), so no invocation reads
+// a whole island and an island may be as large as a scene.
+
+// Empties each island's words: no time yet (the bits of the largest f32), not held.
 @compute @workgroup_size(WORKGROUP)
-fn joint_rest(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn joint_rest_clear(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.island_count) {
         return;
     }
-    // island k's joints follow the bodies' joint lists in joint_start
-    let at = params.body_count + 1u + gid.x;
-    let first = joint_start[at];
-    let end = joint_start[at + 1u];
-    var rest = 3.4e38;
-    var held = false;
-    for (var e = first; e < end; e = e + 1u) {
-        let j = joint_refs[e];
-        let s = out_state(j.body);
-        rest = min(rest, s.rest_time);
-        held = held || (s.pos_low & HELD) != 0u;
-        if (j.partner == WORLD || is_fixed(props_of(j.partner))) {
-            held = true;
-        } else {
-            let o = out_state(j.partner);
-            rest = min(rest, o.rest_time);
-            held = held || (o.pos_low & HELD) != 0u;
+    atomicStore(&island_rest[2u * gid.x], bitcast<u32>(3.4e38f));
+    atomicStore(&island_rest[2u * gid.x + 1u], 0u);
+}
+
+// The island of the nth joint of the islands' lists (they follow the bodies'
+// lists in joint_start, island k's from joint_start[body_count + 1 + k]),
+// or NONE past the last: a binary search over the islands' starts.
+fn island_joint(nth: u32) -> vec2<u32> {
+    let islands = params.body_count + 1u;
+    let e = joint_start[islands] + nth;
+    if (e >= joint_start[islands + params.island_count]) {
+        return vec2<u32>(NONE, e);
+    }
+    // the last island whose start is at or before e: lo's start <= e < hi's
+    var lo = 0u;
+    var hi = params.island_count;
+    for (var step = 0u; step < 32u; step = step + 1u) {
+        let mid = (lo + hi) / 2u;
+        if (hi - lo > 1u && joint_start[islands + mid] <= e) {
+            lo = mid;
+        } else if (hi - lo > 1u) {
+            hi = mid;
         }
     }
-    rest = select(0.0, rest, held);
-    for (var e = first; e < end; e = e + 1u) {
-        set_rest_time(joint_refs[e].body, rest);
-        let partner = joint_refs[e].partner;
-        if (partner != WORLD && !is_fixed(props_of(partner))) {
-            set_rest_time(partner, rest);
-        }
+    return vec2<u32>(lo, e);
+}
+
+// Whether the joints may move body i (not the world, not fixed).
+fn joint_moves(i: u32) -> bool {
+    return i != WORLD && !is_fixed(props_of(i));
+}
+
+// Each joint adds its bodies' rest times and holds to its island's words.
+@compute @workgroup_size(WORKGROUP)
+fn joint_rest_gather(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let at = island_joint(dispatch_index(gid, groups));
+    if (at.x == NONE) {
+        return;
+    }
+    let j = joint_refs[at.y];
+    let s = out_state(j.body);
+    var rest = s.rest_time;
+    var held = (s.pos_low & HELD) != 0u;
+    if (joint_moves(j.partner)) {
+        let o = out_state(j.partner);
+        rest = min(rest, o.rest_time);
+        held = held || (o.pos_low & HELD) != 0u;
+    } else {
+        held = true;
+    }
+    // a rest time is never negative, so its bits order as the times do
+    atomicMin(&island_rest[2u * at.x], bitcast<u32>(max(rest, 0.0)));
+    if (held) {
+        atomicOr(&island_rest[2u * at.x + 1u], 1u);
+    }
+}
+
+// Each joint gives its bodies the island's rest time (a body of several
+// joints is given the same time by each).
+@compute @workgroup_size(WORKGROUP)
+fn joint_rest(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let at = island_joint(dispatch_index(gid, groups));
+    if (at.x == NONE) {
+        return;
+    }
+    let held = atomicLoad(&island_rest[2u * at.x + 1u]) != 0u;
+    let rest = select(0.0, bitcast<f32>(atomicLoad(&island_rest[2u * at.x])), held);
+    let j = joint_refs[at.y];
+    set_rest_time(j.body, rest);
+    if (joint_moves(j.partner)) {
+        set_rest_time(j.partner, rest);
     }
 }
 

@@ -31,10 +31,11 @@ pub enum Buffer {
     Points3 = 20,
     Snaps1 = 21,
     CellBounds = 22,
+    IslandRest = 23,
 }
 
 impl Buffer {
-    pub const ALL: [Buffer; 23] = [
+    pub const ALL: [Buffer; 24] = [
         Buffer::Params,
         Buffer::Props,
         Buffer::StateIn,
@@ -58,6 +59,7 @@ impl Buffer {
         Buffer::Points3,
         Buffer::Snaps1,
         Buffer::CellBounds,
+        Buffer::IslandRest,
     ];
 
     pub fn binding(self) -> u32 {

@@ -8,7 +8,7 @@
 //!    clips the face contacts, over the top run of the pool
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl), after
 //!    applying the last substep's restitution in a step's later substeps
-//! 5. `solve_contacts`, `solve`, `joint_rest`, `solve_joints` — the substep's share of the
+//! 5. `solve_contacts`, `solve`, `joint_rest_*`, `solve_joints` — the substep's share of the
 //!    `iterations` sweeps of corrective snaps: per manifold what it asks of its bodies, then
 //!    per body the sum (Jacobi), then (only in scenes with joints; `joint_rest` once a
 //!    substep) per colour of joint paths each path's joints in turn (Gauss-Seidel)

@@ -26,6 +26,8 @@ pub enum Stage {
     Integrate,
     SolveContacts,
     Solve,
+    JointRestClear,
+    JointRestGather,
     JointRest,
     SolveJoints,
     RestitutionContacts,
@@ -51,6 +53,8 @@ pub(crate) enum Over {
     Manifolds,
     /// The joint islands (see `joint_lists`).
     Islands,
+    /// The joints of the islands' lists (see `joint_lists`).
+    IslandJoints,
     /// The joint paths of one colour (see `joint_lists`): the widest
     /// colour's count, each dispatch bounded by its Params.
     Paths,
@@ -151,7 +155,7 @@ impl StageInfo {
 }
 
 /// Every stage, in the order of `Stage` (checked as the table is built).
-pub(crate) const TABLE: [StageInfo; 21] = {
+pub(crate) const TABLE: [StageInfo; 23] = {
     use shaders::{GRID_PASS, INTEGRATE_PASS, NARROWPHASE_PASS, PAIRS_PASS, RESTITUTION_PASS, SOLVE_PASS};
     use Buffer::*;
     use Part::{Broadphase, Narrowphase};
@@ -281,9 +285,24 @@ pub(crate) const TABLE: [StageInfo; 21] = {
         },
         S {
             over: Over::Islands,
+            runs: Runs::InSubsteps,
+            reads: &[Params],
+            writes: &[IslandRest],
+            ..S::row(Stage::JointRestClear, "joint_rest_clear", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::IslandJoints,
             poses: Poses::InPlace,
             runs: Runs::InSubsteps,
-            reads: JOINT_READS,
+            reads: &[Params, Props, StateOut, JointStart, JointRefs, IslandRest],
+            writes: &[IslandRest],
+            ..S::row(Stage::JointRestGather, "joint_rest_gather", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::IslandJoints,
+            poses: Poses::InPlace,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, JointStart, JointRefs, IslandRest],
             writes: &[StateOut],
             ..S::row(Stage::JointRest, "joint_rest", SOLVE_PASS, Part::Solve)
         },

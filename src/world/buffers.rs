@@ -43,6 +43,9 @@ pub(super) struct WorldData {
     /// (copied into the tail of `sorted`, where the passes read them) and the
     /// joint lists (the snapshot's scene hash reads them all).
     pub statics: [wgpu::Buffer; 3],
+    /// Each joint island's two words for `joint_rest` (its least rest time
+    /// and whether it is held), emptied before each use.
+    pub island_rest: wgpu::Buffer,
     /// Working buffers of the passes: vel0, and the grid's cell_count,
     /// cell_start, block_sums, sorted and cell_bounds.
     pub scratch: [wgpu::Buffer; 6],
@@ -129,6 +132,7 @@ impl WorldData {
             bind_groups: None,
             props: props_buffer(device, n),
             statics: statics_buffers(device, large, joints),
+            island_rest: island_rest_buffer(device, joints),
             scratch,
             batch_start: [batch_state, storage("batch start/status", Status::BYTES)],
         };
@@ -171,6 +175,11 @@ impl WorldData {
             bind_groups: None,
             props: props_buffer(device, n),
             statics: statics_buffers(device, large, joints),
+            island_rest: if self.island_rest.size() >= island_rest_bytes(joints) {
+                self.island_rest.clone()
+            } else {
+                island_rest_buffer(device, joints)
+            },
             scratch,
             batch_start: [batch_state, self.batch_start[1].clone()],
         }
@@ -240,6 +249,7 @@ impl WorldData {
             Buffer::PairMeta => &self.pair_meta,
             Buffer::BodyPairs => &self.body_pairs,
             Buffer::CellBounds => cell_bounds,
+            Buffer::IslandRest => &self.island_rest,
         }
     }
 
@@ -282,6 +292,7 @@ impl WorldData {
             &self.body_pairs,
             &self.dispatch,
             &self.props,
+            &self.island_rest,
         ];
         buffers.iter().map(|b| b.size()).sum::<u64>()
             + self.states.iter().chain(&self.statics).chain(&self.scratch).chain(&self.batch_start).map(|b| b.size()).sum::<u64>()
@@ -340,6 +351,15 @@ impl BodyBuffers {
 /// The bodies' properties, exactly `n` of them (at least one element).
 fn props_buffer(device: &wgpu::Device, n: usize) -> wgpu::Buffer {
     storage_buffer(device, "props", (n * size_of::<BodyProps>()) as u64)
+}
+
+/// Bytes of `WorldData::island_rest`: two words an island, at least one island's.
+fn island_rest_bytes(joints: &JointLists) -> u64 {
+    8 * u64::from(joints.islands.max(1))
+}
+
+fn island_rest_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffer {
+    storage_buffer(device, "joints/island_rest", island_rest_bytes(joints))
 }
 
 /// The statics (`WorldData::statics`), exactly as large as their lists.

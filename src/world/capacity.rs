@@ -145,20 +145,15 @@ pub(super) fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {
 }
 
 /// Whether `joint_rest` can keep every joint island's rest time (where
-/// bodies sleep; it runs only then): one invocation reads and writes an
-/// island's, and where the driver ends an invocation's loops past
-/// `Gpu::loop_trips` (lavapipe), an island of n joints takes 2n trips.
-/// (The sweeps go along paths of at most `PATH_JOINTS` joints, which any
-/// island is cut into.)
+/// bodies sleep; it runs only then): its passes take one invocation per
+/// joint of the islands, in one row of workgroups.
 pub(super) fn check_islands(gpu: &Gpu, joints: &JointLists, bodies: usize) -> Result<(), Error> {
-    let (Some(trips), largest) = (gpu.loop_trips(), joints.largest_island(bodies)) else { return Ok(()) };
-    let most = trips / 2;
-    if largest > most {
+    let most = u64::from(gpu.limits.max_compute_workgroups_per_dimension) * u64::from(WORKGROUP);
+    let joined = u64::from(joints.island_joints(bodies));
+    if joined > most {
         return Err(Error::Capacity(format!(
-            "joints: an island of {largest} joints (bodies joined to each other, directly or through others) is more \
-             than this adapter can keep asleep or awake as one: one invocation reads an island's rest times, and {} \
-             ends an invocation's loops after 65535 trips, room for islands of at most {most} joints (with \
-             settings.sleeping off there is no such limit)",
+            "joints: {joined} joints keep their islands asleep or awake as one, one invocation each, but {} \
+             dispatches at most {most} invocations in a row (with settings.sleeping off there is no such limit)",
             gpu.info.name
         )));
     }

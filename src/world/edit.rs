@@ -132,6 +132,7 @@ impl World {
         self.large_count = large.len() as u32;
         self.body_count = n as u32;
         self.island_count = joints.islands;
+        self.island_joints = joints.island_joints(n);
         self.path_colours = joints.colours;
         self.scene = scene;
         // both state buffers hold the poses

@@ -195,7 +195,7 @@ impl World {
                 if self.island_count > 0 {
                     // islands sleep as one only where bodies sleep at all
                     if sweep == 0 && self.settings.sleeping {
-                        plan.push((Stage::JointRest, at));
+                        plan.extend([Stage::JointRestClear, Stage::JointRestGather, Stage::JointRest].map(|s| (s, at)));
                     }
                     plan.extend((1..per_substep).map(|c| (Stage::SolveJoints, at + c)));
                 }
@@ -269,6 +269,7 @@ impl World {
             Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_SPAN),
             Over::One => 1,
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
+            Over::IslandJoints => self.island_joints.div_ceil(WORKGROUP),
             Over::Paths => self.path_colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0).div_ceil(WORKGROUP),
             Over::Pairs | Over::Manifolds | Over::Listed => unreachable!("dispatched indirectly"),
         };

@@ -62,6 +62,9 @@ pub struct World {
     /// Joint islands (`joint_rest` and `solve_joints` run only when there
     /// are any).
     island_count: u32,
+    /// The joints of the islands' lists: `joint_rest` runs one invocation
+    /// for each.
+    island_joints: u32,
     /// Where each colour of the joint paths begins, and after the last its
     /// end (`JointLists::colours`): `solve_joints` runs once per colour.
     path_colours: Vec<u32>,
@@ -128,6 +131,7 @@ impl World {
             large_count: large.len() as u32,
             body_count: n as u32,
             island_count: joints.islands,
+            island_joints: joints.island_joints(n),
             path_colours: joints.colours.clone(),
             speed_limits: true,
             current: 0,

@@ -147,10 +147,10 @@ pub(crate) const PATH_JOINTS: usize = 128;
 pub(crate) const CUT_PATH_CLOSES: u32 = 512;
 
 impl JointLists {
-    /// The most joints one island holds (0 without joints), of a scene of
-    /// `bodies` bodies.
-    pub(crate) fn largest_island(&self, bodies: usize) -> u32 {
-        self.starts[bodies + 1..bodies + 2 + self.islands as usize].windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0)
+    /// The joints of all the islands' lists (`joint_rest`'s invocations),
+    /// of a scene of `bodies` bodies.
+    pub(crate) fn island_joints(&self, bodies: usize) -> u32 {
+        self.starts[bodies + 1 + self.islands as usize] - self.starts[bodies + 1]
     }
 
     /// The paths' colours: `solve_joints` is dispatched once per colour.
