@@ -36,6 +36,9 @@ const SETTLE_SPEED: f32 = 1.0;
 // velocity against gravity only while the body rises slower than this (m/s).
 const SUPPORT_SPEED: f32 = 0.2;
 
+// The deepest a body may end a sweep in the ground (m; see solve).
+const GROUND_DEPTH: f32 = 0.01;
+
 // Normal pushes against ends that stay are split as friction is (bindings.wgsl's
 // friction_split), or the sweeps overshoot and the body rattles: held by k > 0
 // such ends, a body counts its inverse mass max(1, c_r s) times against them,
@@ -260,6 +263,20 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         s.pos = s.pos + settle.dx * share;
         s.rot = quat_add_rotation(s.rot, settle.dtheta * share);
         s.prev_rot = quat_add_rotation(s.prev_rot, settle.dtheta * share);
+    }
+    // The ground stays whatever presses on it: partners far heavier than a
+    // body outweigh its ground contact in the sum, and a pile of heavy boxes
+    // on light ones pushed the light ones through it. A body left deeper than
+    // GROUND_DEPTH in the ground is lifted to it, both poses alike. Not a
+    // jointed body: its joints, closed after the sweep, would pull it back.
+    if (params.has_ground != 0u && !jointed) {
+        var reach = p.half_extents.x;
+        if (p.shape != SHAPE_SPHERE) {
+            let m = quat_to_mat(s.rot);
+            reach = dot(abs(vec3<f32>(m[0].y, m[1].y, m[2].y)), p.half_extents.xyz);
+        }
+        let depth = params.ground_height - (s.pos.y - reach);
+        s.pos.y = s.pos.y + max(depth - GROUND_DEPTH, 0.0);
     }
     set_state(i, s);
 }

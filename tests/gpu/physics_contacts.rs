@@ -475,6 +475,34 @@ fn same_scene_same_bits() {
     assert!(bytemuck::cast_slice::<_, u8>(&first) == bytemuck::cast_slice::<_, u8>(&second), "two runs differ");
 }
 
+/// A pile of 1000 cubes whose upper half weighs 100 times the lower half
+/// keeps every cube out of the ground, sampled every 10 steps for 10 s. A
+/// light cube's ground contact is outweighed in the sums by the heavy ones
+/// pressing on it, and it was pushed 2 m through the ground; now a body left
+/// deeper than 1 cm in it is lifted (solve.wgsl's `GROUND_DEPTH`).
+#[test]
+fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_the_ground() {
+    let mut scene = scenes::pile(1000, 1);
+    let mut heights: Vec<f32> = scene.bodies.iter().map(|b| b.position[1]).collect();
+    heights.sort_by(f32::total_cmp);
+    let middle = heights[heights.len() / 2];
+    for b in scene.bodies.iter_mut().filter(|b| b.position[1] > middle) {
+        b.mass *= 100.0;
+    }
+    let Some(mut w) = world(&scene) else { return };
+    let mut deepest = 0.0f32;
+    for _ in 0..60 {
+        w.step(10).unwrap();
+        for b in w.read_state().unwrap() {
+            let r = Quat::from_array(b.orientation);
+            let reach: f32 = [Vec3::X, Vec3::Y, Vec3::Z].iter().map(|&axis| (r * axis).y.abs() * 0.5).sum();
+            deepest = deepest.max(reach - b.position[1]);
+        }
+    }
+    eprintln!("heavy on light: deepest a cube went into the ground {deepest} m");
+    assert!(deepest < 0.011, "a cube went {deepest} m into the ground");
+}
+
 /// Thirty unit boxes placed at one point on the ground, under gravity, part
 /// along the ground without a fault, under 4 m/s and under 3 m, with the
 /// default settings and with the interface's suggested `iterations` 8. Each
