@@ -205,6 +205,18 @@ struct JointRef {
     body: u32,               // the body at this end
 }
 
+// Half extents of a body's world box: |R| h for a box, the radius for a sphere.
+fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
+    if (p.shape == SHAPE_SPHERE) {
+        return vec3<f32>(p.half_extents.x);
+    }
+    let q = s.rot;
+    let x = quat_rotate(q, vec3<f32>(p.half_extents.x, 0.0, 0.0));
+    let y = quat_rotate(q, vec3<f32>(0.0, p.half_extents.y, 0.0));
+    let z = quat_rotate(q, vec3<f32>(0.0, 0.0, p.half_extents.z));
+    return abs(x) + abs(y) + abs(z);
+}
+
 // Hamilton product a * b.
 fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(

@@ -85,18 +85,6 @@ fn is_fast(size: f32, moves: u32) -> bool {
     return size > fast_size() && moves != SLEEPS;
 }
 
-// Half extents of a body's world box: |R| h for a box, the radius for a sphere.
-fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
-    if (p.shape == SHAPE_SPHERE) {
-        return vec3<f32>(p.half_extents.x);
-    }
-    let q = s.rot;
-    let x = quat_rotate(q, vec3<f32>(p.half_extents.x, 0.0, 0.0));
-    let y = quat_rotate(q, vec3<f32>(0.0, p.half_extents.y, 0.0));
-    let z = quat_rotate(q, vec3<f32>(0.0, 0.0, p.half_extents.z));
-    return abs(x) + abs(y) + abs(z);
-}
-
 // Counts body i into its bucket and writes what the pair walks read of it
 // (PairMeta's moves, extent, bound, reach). Invocation 0 also empties the
 // pool's counters and the step's flags (the step's first pass).

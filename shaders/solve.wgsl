@@ -270,12 +270,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // GROUND_DEPTH in the ground is lifted to it, both poses alike. Not a
     // jointed body: its joints, closed after the sweep, would pull it back.
     if (params.has_ground != 0u && !jointed) {
-        var reach = p.half_extents.x;
-        if (p.shape != SHAPE_SPHERE) {
-            let m = quat_to_mat(s.rot);
-            reach = dot(abs(vec3<f32>(m[0].y, m[1].y, m[2].y)), p.half_extents.xyz);
-        }
-        let depth = params.ground_height - (s.pos.y - reach);
+        let depth = params.ground_height - (s.pos.y - world_extent(s, p).y);
         s.pos.y = s.pos.y + max(depth - GROUND_DEPTH, 0.0);
     }
     set_state(i, s);
