@@ -283,48 +283,47 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
 // all the way. No two paths of a colour share a body that moves, and a path's
 // order is fixed, so nothing depends on thread timing. See docs/decisions/joints.md.
 
-// Closes one joint (eq. 9): body j.body and its partner (or the world) move
-// along the gap between the anchors, by their generalised inverse masses, and
-// the displacement moves with the pose, as solve's snaps do.
-fn close_joint(j: JointRef) {
-    let a = j.body;
+// Closes one joint (eq. 9) on the states *sa and *sb of its body and partner
+// (sb unused for a joint to the world): they move along the gap between the
+// anchors, by their generalised inverse masses, and the displacement moves
+// with the pose, as solve's snaps do. Says which of the two it moved.
+fn close_joint(j: JointRef, sa: ptr<function, BodyState>, sb: ptr<function, BodyState>) -> vec2<bool> {
     let joined = j.partner != WORLD;
-    let b = select(a, j.partner, joined);
-    var sa = out_state(a);
-    var sb = out_state(b);
-    let pa = props_of(a);
-    let pb = props_of(b);
-    let ra = quat_rotate(sa.rot, j.local_self);
-    let rb = quat_rotate(sb.rot, j.local_partner);
-    let gap = select(j.local_partner, sb.pos + rb, joined) - (sa.pos + ra);
+    let pa = props_of(j.body);
+    let pb = props_of(select(j.body, j.partner, joined));
+    let ra = quat_rotate((*sa).rot, j.local_self);
+    let rb = quat_rotate((*sb).rot, j.local_partner);
+    let gap = select(j.local_partner, (*sb).pos + rb, joined) - ((*sa).pos + ra);
     let dist = length(gap);
     // the gap at the previous poses closes at no more than MAX_DEPENETRATION_SPEED
     // (a full snap becomes velocity); what this substep opened closes whole
-    let moved_a = sa.disp + (ra - quat_rotate(sa.prev_rot, j.local_self));
-    let moved_b = select(vec3<f32>(0.0), sb.disp + (rb - quat_rotate(sb.prev_rot, j.local_partner)), joined);
+    let moved_a = (*sa).disp + (ra - quat_rotate((*sa).prev_rot, j.local_self));
+    let moved_b = select(vec3<f32>(0.0), (*sb).disp + (rb - quat_rotate((*sb).prev_rot, j.local_partner)), joined);
     let before = length(gap - (moved_b - moved_a));
     let bounded = max(before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
     let n = gap / max(dist, 1e-30); // a moves along n, b against it
-    let wa = select(effective_inv_mass(pa, sa.rot, ra, n), 0.0, is_fixed(pa));
-    let wb = select(0.0, effective_inv_mass(pb, sb.rot, rb, n), joined && !is_fixed(pb));
+    // each end's turn per unit push along n, found once for its mass and its move
+    let turn_a = inv_inertia_world((*sa).rot, pa.inv_inertia.xyz, cross(ra, n));
+    let turn_b = inv_inertia_world((*sb).rot, pb.inv_inertia.xyz, cross(rb, n));
+    let wa = select(pa.inv_inertia.w + dot(cross(ra, n), turn_a), 0.0, is_fixed(pa));
+    let wb = select(0.0, pb.inv_inertia.w + dot(cross(rb, n), turn_b), joined && !is_fixed(pb));
     if (dist <= bounded + 1e-7 || wa + wb <= 0.0) {
-        return;
+        return vec2<bool>(false);
     }
     let lambda = (dist - bounded) / (wa + wb);
     if (wa > 0.0) {
         let dx = n * (pa.inv_inertia.w * lambda);
-        sa.pos = sa.pos + dx;
-        sa.disp = sa.disp + dx;
-        sa.rot = quat_add_rotation(sa.rot, inv_inertia_world(sa.rot, pa.inv_inertia.xyz, cross(ra, n)) * lambda);
-        set_state(a, sa);
+        (*sa).pos = (*sa).pos + dx;
+        (*sa).disp = (*sa).disp + dx;
+        (*sa).rot = quat_add_rotation((*sa).rot, turn_a * lambda);
     }
     if (wb > 0.0) {
         let dx = n * (-pb.inv_inertia.w * lambda);
-        sb.pos = sb.pos + dx;
-        sb.disp = sb.disp + dx;
-        sb.rot = quat_add_rotation(sb.rot, inv_inertia_world(sb.rot, pb.inv_inertia.xyz, cross(rb, n)) * -lambda);
-        set_state(b, sb);
+        (*sb).pos = (*sb).pos + dx;
+        (*sb).disp = (*sb).disp + dx;
+        (*sb).rot = quat_add_rotation((*sb).rot, turn_b * -lambda);
     }
+    return vec2<bool>(wa > 0.0, wb > 0.0);
 }
 
 // Passes "joint_rest_clear", "joint_rest_gather" and "joint_rest", once a
@@ -436,8 +435,53 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = end - first;
     let closes = joint_start[params.body_count + params.island_count + 3u + params.path_count + path];
     let sweeps = max(min(params.joint_sweeps, closes / (2u * n)), 1u);
+    // Consecutive joints of a path share a body, so the two bodies of the last
+    // joint closed stay in registers (held[k], its state kept[k], moved[k] if
+    // not yet written back) rather than going to memory and back each close.
+    var held = vec2<u32>(NONE);
+    var kept: array<BodyState, 2>;
+    var moved = vec2<bool>(false);
     for (var t = 0u; t < 2u * n * sweeps; t = t + 1u) {
         let r = t % (2u * n);
-        close_joint(joint_refs[select(first + r, end - 1u - (r - n), r >= n)]);
+        let j = joint_refs[select(first + r, end - 1u - (r - n), r >= n)];
+        let a = j.body;
+        let b = select(a, j.partner, j.partner != WORLD);
+        // a held body this joint does not close is done with: written back
+        for (var k = 0u; k < 2u; k = k + 1u) {
+            if (moved[k] && held[k] != a && held[k] != b) {
+                set_state(held[k], kept[k]);
+            }
+        }
+        var sa: BodyState;
+        var sb: BodyState;
+        var was = vec2<bool>(false);
+        if (held[0] == a) {
+            sa = kept[0];
+            was.x = moved[0];
+        } else if (held[1] == a) {
+            sa = kept[1];
+            was.x = moved[1];
+        } else {
+            sa = out_state(a);
+        }
+        if (held[0] == b) {
+            sb = kept[0];
+            was.y = moved[0];
+        } else if (held[1] == b) {
+            sb = kept[1];
+            was.y = moved[1];
+        } else {
+            sb = out_state(b);
+        }
+        let now = close_joint(j, &sa, &sb);
+        held = vec2<u32>(a, select(NONE, b, b != a));
+        kept[0] = sa;
+        kept[1] = sb;
+        moved = (was | now) & vec2<bool>(true, b != a);
+    }
+    for (var k = 0u; k < 2u; k = k + 1u) {
+        if (moved[k]) {
+            set_state(held[k], kept[k]);
+        }
     }
 }
