@@ -312,17 +312,6 @@ fn friction_split(i: u32, relaxation: f32) -> f32 {
     return max(1.0, relaxation * f32(pair_meta[i].held));
 }
 
-// Dynamic friction between two bodies that both move: each manifold undoes the
-// whole relative slide, so a body in k manifolds counts its inverse mass
-// max(1, k) times, as against ends that stay; summed in full, the undos of a
-// body pressed by many overshot and grew (boxes placed at one point).
-fn sliding_split(i: u32) -> f32 {
-    if (i == GROUND) {
-        return 1.0;
-    }
-    return max(1.0, f32(pair_meta[i].contacts));
-}
-
 // Whether body i has a joint: its contacts then neither split their normal pushes
 // against ends that stay nor settle or cap their support (docs/decisions/joints.md).
 fn is_jointed(i: u32) -> bool {

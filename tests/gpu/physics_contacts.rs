@@ -516,8 +516,8 @@ fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_the_ground() {
 /// pair's dynamic friction undoes the whole slide between them and each push
 /// asks the whole depth, and a body pressed by many summed them all: the sums
 /// overshot and grew (at the defaults they rose 27 m at 34 m/s). Now a body's
-/// dynamic friction is split by its manifolds (bindings.wgsl's
-/// `sliding_split`), and its summed pushes are capped (solve.wgsl).
+/// summed dynamic friction (restitution.wgsl's `restituted`) and its summed
+/// pushes (solve.wgsl) are capped.
 #[test]
 fn thirty_boxes_placed_at_one_point_on_the_ground_part() {
     for (label, iterations) in [("default", 9), ("suggested iterations 8", 8)] {
