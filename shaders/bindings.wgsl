@@ -331,7 +331,7 @@ fn contact_end(i: u32) -> ContactEnd {
     if (i == GROUND) {
         let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         let identity = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
-        return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), identity, mat3x3<f32>(), mat3x3<f32>(), false,
+        return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), identity, mat3x3<f32>(), mat3x3<f32>(), false, false,
                           params.ground_restitution, params.ground_friction, 0.0);
     }
     let s = state_of(i);
@@ -343,6 +343,6 @@ fn contact_end(i: u32) -> ContactEnd {
         radius = props_of(i).half_extents.x;
     }
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
-                      world_inv_inertia(r, p.inv_inertia.xyz), moves_by_contacts(s, p),
+                      world_inv_inertia(r, p.inv_inertia.xyz), moves_by_contacts(s, p), is_fixed(p),
                       p.restitution, p.friction, radius);
 }

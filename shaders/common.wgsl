@@ -125,8 +125,8 @@ struct ManifoldPoints {
 
 // What one manifold asks of one of its bodies in a sweep, summed over its
 // points: a move (m; m/s in restitution) and a turn (rad; rad/s), world axes;
-// `count`: 1 if it snapped the body (solve) or the points that acted
-// (restitution); `flags`: SNAP_PRESSED, the settling share above SETTLE_SHIFT
+// `count`: 1 if it snapped the body (solve, with SNAP_FIXED_PARTNER) or the
+// points that acted (restitution); `flags`: SNAP_PRESSED, the settling share above SETTLE_SHIFT
 // and the support share above SUPPORT_SHIFT (solve.wgsl). A manifold's two,
 // a's then b's, sit at 2 x its slot (`snap_of`). 32 bytes.
 struct EndSnap {
@@ -137,6 +137,8 @@ struct EndSnap {
 }
 
 const SNAP_PRESSED: u32 = 1u;
+// In an EndSnap's count (solve): the manifold's other end is a fixed body.
+const SNAP_FIXED_PARTNER: u32 = 0x80000000u;
 const SETTLE_SHIFT: u32 = 16u;
 const SETTLE_ONE: f32 = 65535.0;
 const SUPPORT_SHIFT: u32 = 1u;
@@ -349,6 +351,7 @@ struct ContactEnd {
     turn_m: mat3x3<f32>,      // rot's matrix less prev_rot's: what the last turn moved a point by
     inv_i_world: mat3x3<f32>, // the inverse inertia in world axes (world_inv_inertia)
     moves: bool,            // awake and not fixed: the contacts may move it
+    fixed: bool,            // a fixed body (not the ground)
     restitution: f32,
     friction: f32,
     radius: f32,            // a sphere's radius (m); 0 for a box or the ground

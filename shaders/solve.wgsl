@@ -179,8 +179,10 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let settle = u32(round(clamp(old_depth / max(all_depth, 1e-30), 0.0, 1.0) * SETTLE_ONE));
     let support = u32(round(clamp(shallow_depth / max(all_depth, 1e-30), 0.0, 1.0) * SUPPORT_ONE));
     let flags = select(0u, SNAP_PRESSED, pressed != 0u) | (settle << SETTLE_SHIFT) | (support << SUPPORT_SHIFT);
-    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns, touched, flags));
-    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns, touched, flags));
+    let against_a = select(0u, SNAP_FIXED_PARTNER, eb.fixed);
+    let against_b = select(0u, SNAP_FIXED_PARTNER, ea.fixed);
+    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns, touched | against_a, flags));
+    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns, touched | against_b, flags));
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -208,6 +210,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     var support_dx = vec3<f32>(0.0);
     // the longest translation one partner asks (the cap below)
     var longest = 0.0;
+    var fixed_partners = false;
     let jointed = is_jointed(i);
     for (var e = first; e < end; e = e + 1u) {
         let snap = snap_of(body_pairs[e]);
@@ -227,7 +230,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
             acc.dtheta = acc.dtheta + snap.dtheta;
         }
         longest = max(longest, length(snap.dx) * (1.0 - f32(settles) / SETTLE_ONE));
-        touching = touching + snap.count;
+        touching = touching + (snap.count & ~SNAP_FIXED_PARTNER);
+        fixed_partners = fixed_partners || (snap.count & SNAP_FIXED_PARTNER) != 0u;
         flags = flags | snap.flags;
     }
     // summed turns overshoot, so a partner's points share one turn and the
@@ -273,7 +277,42 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         let depth = params.ground_height - (s.pos.y - world_extent(s, p).y);
         s.pos.y = s.pos.y + max(depth - GROUND_DEPTH, 0.0);
     }
+    // The same for fixed bodies: walls and floors made of boxes stay too.
+    if (fixed_partners && !jointed) {
+        for (var e = first; e < end; e = e + 1u) {
+            let r = body_pairs[e];
+            if ((snap_of(r).count & SNAP_FIXED_PARTNER) != 0u) {
+                s.pos = s.pos + out_of_fixed(r, s, p);
+            }
+        }
+    }
     set_state(i, s);
+}
+
+// How far body i, at pose s, must move to be no deeper than GROUND_DEPTH in
+// the fixed partner of its manifold reference r, along the manifold's normal:
+// its points measured as solve_contacts measures them.
+fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
+    let k = r >> 1u;
+    let is_b = (r & 1u) != 0u;
+    let m = manifold_of(k);
+    let partner = contact_end(select(m.b, m.a, is_b));
+    // n from this body toward its partner
+    let n = select(m.normal, -m.normal, is_b);
+    let rot_m = quat_to_mat(s.rot);
+    let at = point_slot(k);
+    var deepest = 0.0;
+    for (var q = 0u; q < m.count; q = q + 1u) {
+        let pt = point_of(at, q);
+        var mine = select(pt.local_a, pt.local_b, is_b);
+        if (p.shape == SHAPE_SPHERE) {
+            mine = (n * p.half_extents.x) * rot_m;
+        }
+        let theirs = end_point(partner, select(pt.local_b, pt.local_a, is_b), -n);
+        let overlap = dot((s.pos + rot_m * mine) - (partner.pos + partner.rot_m * theirs), n);
+        deepest = max(deepest, overlap);
+    }
+    return -n * max(deepest - GROUND_DEPTH, 0.0);
 }
 
 // Pass "solve_joints", after every solve, once per colour of joint paths
