@@ -302,7 +302,10 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
     let rot_m = quat_to_mat(s.rot);
     let at = point_slot(k);
     var deepest = 0.0;
-    for (var q = 0u; q < m.count; q = q + 1u) {
+    // bounded by MAX_POINTS too: bounded by the count alone, the loop as
+    // lavapipe compiled it found no depth for a box square on a fixed floor
+    let count = min(m.count, MAX_POINTS);
+    for (var q = 0u; q < count; q = q + 1u) {
         let pt = point_of(at, q);
         var mine = select(pt.local_a, pt.local_b, is_b);
         if (p.shape == SHAPE_SPHERE) {
