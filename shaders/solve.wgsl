@@ -457,6 +457,23 @@ fn joint_rest(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     }
 }
 
+// Body i's state along a path: from the registers if the joint just closed
+// holds it (held, kept), else from memory.
+fn held_or_loaded(i: u32, held: vec2<u32>, kept: array<BodyState, 2>) -> BodyState {
+    if (held[0] == i) {
+        return kept[0];
+    }
+    if (held[1] == i) {
+        return kept[1];
+    }
+    return out_state(i);
+}
+
+// Whether body i is held in the registers and moved since it was written.
+fn unwritten(i: u32, held: vec2<u32>, moved: vec2<bool>) -> bool {
+    return (held[0] == i && moved[0]) || (held[1] == i && moved[1]);
+}
+
 @compute @workgroup_size(WORKGROUP)
 fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     let path = params.path_first + gid.x;
@@ -494,27 +511,9 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
                 set_state(held[k], kept[k]);
             }
         }
-        var sa: BodyState;
-        var sb: BodyState;
-        var was = vec2<bool>(false);
-        if (held[0] == a) {
-            sa = kept[0];
-            was.x = moved[0];
-        } else if (held[1] == a) {
-            sa = kept[1];
-            was.x = moved[1];
-        } else {
-            sa = out_state(a);
-        }
-        if (held[0] == b) {
-            sb = kept[0];
-            was.y = moved[0];
-        } else if (held[1] == b) {
-            sb = kept[1];
-            was.y = moved[1];
-        } else {
-            sb = out_state(b);
-        }
+        var sa = held_or_loaded(a, held, kept);
+        var sb = held_or_loaded(b, held, kept);
+        let was = vec2<bool>(unwritten(a, held, moved), unwritten(b, held, moved));
         let now = close_joint(j, &sa, &sb);
         held = vec2<u32>(a, select(NONE, b, b != a));
         kept[0] = sa;

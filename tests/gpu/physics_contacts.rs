@@ -482,13 +482,8 @@ fn same_scene_same_bits() {
     assert!(bytemuck::cast_slice::<_, u8>(&first) == bytemuck::cast_slice::<_, u8>(&second), "two runs differ");
 }
 
-/// A pile of 1000 cubes whose upper half weighs 100 times the lower half
-/// keeps every cube out of the ground, sampled every 10 steps for 10 s. A
-/// light cube's ground contact is outweighed in the sums by the heavy ones
-/// pressing on it, and it was pushed 2 m through the ground; now a body left
-/// deeper than 1 cm in it is lifted (solve.wgsl's `GROUND_DEPTH`).
-#[test]
-fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_the_ground() {
+/// A pile of 1000 cubes whose upper half weighs 100 times the lower half.
+fn heavy_on_light_pile() -> Scene {
     let mut scene = scenes::pile(1000, 1);
     let mut heights: Vec<f32> = scene.bodies.iter().map(|b| b.position[1]).collect();
     heights.sort_by(f32::total_cmp);
@@ -496,40 +491,13 @@ fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_the_ground() {
     for b in scene.bodies.iter_mut().filter(|b| b.position[1] > middle) {
         b.mass *= 100.0;
     }
-    let Some(mut w) = world(&scene) else { return };
-    let mut deepest = 0.0f32;
-    for _ in 0..60 {
-        w.step(10).unwrap();
-        for b in w.read_state().unwrap() {
-            let r = Quat::from_array(b.orientation);
-            let reach: f32 = [Vec3::X, Vec3::Y, Vec3::Z].iter().map(|&axis| (r * axis).y.abs() * 0.5).sum();
-            deepest = deepest.max(reach - b.position[1]);
-        }
-    }
-    eprintln!("heavy on light: deepest a cube went into the ground {deepest} m");
-    assert!(deepest < 0.011, "a cube went {deepest} m into the ground");
+    scene
 }
 
-/// The same pile on a fixed box for a floor, with no ground: heavy cubes on
-/// light ones keep every cube within 1 cm of the floor's top, sampled every 10
-/// steps for 10 s. The light cubes' contacts with the floor were outweighed as
-/// their ground contacts were, and cubes fell 247 m through it; now a body left
-/// deeper than 1 cm in a fixed body is lifted out along the contact's normal.
-#[test]
-fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_a_fixed_floor() {
-    let mut scene = scenes::pile(1000, 1);
-    let mut heights: Vec<f32> = scene.bodies.iter().map(|b| b.position[1]).collect();
-    heights.sort_by(f32::total_cmp);
-    let middle = heights[heights.len() / 2];
-    for b in scene.bodies.iter_mut().filter(|b| b.position[1] > middle) {
-        b.mass *= 100.0;
-    }
-    let cubes = scene.bodies.len();
-    scene.ground = None;
-    let mut floor = box_body([40.0, 1.0, 40.0], [0.0, -1.0, 0.0]);
-    floor.fixed = true;
-    scene.bodies.push(floor);
-    let Some(mut w) = world(&scene) else { return };
+/// The deepest any of the first `cubes` unit cubes of `scene` goes below
+/// y = 0 (m), sampled every 10 steps for 10 s.
+fn deepest_below_zero(scene: &Scene, cubes: usize) -> Option<f32> {
+    let mut w = world(scene)?;
     let mut deepest = 0.0f32;
     for _ in 0..60 {
         w.step(10).unwrap();
@@ -539,6 +507,34 @@ fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_a_fixed_floor() {
             deepest = deepest.max(reach - b.position[1]);
         }
     }
+    Some(deepest)
+}
+
+/// The heavy-on-light pile keeps every cube out of the ground. A light
+/// cube's ground contact is outweighed in the sums by the heavy ones pressing
+/// on it, and it was pushed 2 m through the ground; now a body left deeper
+/// than 1 cm in it is lifted (solve.wgsl's `GROUND_DEPTH`).
+#[test]
+fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_the_ground() {
+    let scene = heavy_on_light_pile();
+    let Some(deepest) = deepest_below_zero(&scene, scene.bodies.len()) else { return };
+    eprintln!("heavy on light: deepest a cube went into the ground {deepest} m");
+    assert!(deepest < 0.011, "a cube went {deepest} m into the ground");
+}
+
+/// The same pile on a fixed box for a floor, with no ground. The light
+/// cubes' contacts with the floor were outweighed as their ground contacts
+/// were, and cubes fell 247 m through it; now a body left deeper than 1 cm
+/// in a fixed body is lifted out along the contact's normal.
+#[test]
+fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_a_fixed_floor() {
+    let mut scene = heavy_on_light_pile();
+    let cubes = scene.bodies.len();
+    scene.ground = None;
+    let mut floor = box_body([40.0, 1.0, 40.0], [0.0, -1.0, 0.0]);
+    floor.fixed = true;
+    scene.bodies.push(floor);
+    let Some(deepest) = deepest_below_zero(&scene, cubes) else { return };
     eprintln!("heavy on light on a fixed floor: deepest a cube went into it {deepest} m");
     assert!(deepest < 0.011, "a cube went {deepest} m into the fixed floor");
 }
