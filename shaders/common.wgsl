@@ -219,6 +219,14 @@ fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     return abs(x) + abs(y) + abs(z);
 }
 
+// How far a body's shape reaches from its centre along unit vector dir (m).
+fn reach_along(p: BodyProps, rot: vec4<f32>, dir: vec3<f32>) -> f32 {
+    if (p.shape == SHAPE_SPHERE) {
+        return p.half_extents.x;
+    }
+    return dot(abs(quat_rotate(quat_conj(rot), dir)), p.half_extents.xyz);
+}
+
 // Hamilton product a * b.
 fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(

@@ -290,32 +290,18 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 // How far body i, at pose s, must move to be no deeper than GROUND_DEPTH in
-// the fixed partner of its manifold reference r, along the manifold's normal:
-// its points measured as solve_contacts measures them.
+// the fixed partner of its manifold reference r, along the manifold's normal
+// n: the overlap of the two shapes' extents along n, as the ground lift
+// measures the ground's. Whole shapes, not the manifold's points, so a corner
+// the step's turn brought down counts too.
 fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
-    let k = r >> 1u;
+    let m = manifold_of(r >> 1u);
     let is_b = (r & 1u) != 0u;
-    let m = manifold_of(k);
-    let partner = contact_end(select(m.b, m.a, is_b));
+    let other = select(m.b, m.a, is_b);
     // n from this body toward its partner
     let n = select(m.normal, -m.normal, is_b);
-    let rot_m = quat_to_mat(s.rot);
-    let at = point_slot(k);
-    var deepest = 0.0;
-    // bounded by MAX_POINTS too: bounded by the count alone, the loop as
-    // lavapipe compiled it found no depth for a box square on a fixed floor
-    let count = min(m.count, MAX_POINTS);
-    for (var q = 0u; q < count; q = q + 1u) {
-        let pt = point_of(at, q);
-        var mine = select(pt.local_a, pt.local_b, is_b);
-        if (p.shape == SHAPE_SPHERE) {
-            mine = (n * p.half_extents.x) * rot_m;
-        }
-        let theirs = end_point(partner, select(pt.local_b, pt.local_a, is_b), -n);
-        let overlap = dot((s.pos + rot_m * mine) - (partner.pos + partner.rot_m * theirs), n);
-        deepest = max(deepest, overlap);
-    }
-    return -n * max(deepest - GROUND_DEPTH, 0.0);
+    let overlap = dot(s.pos - state_of(other).pos, n) + reach_along(p, s.rot, n) + reach_along(props_of(other), state_of(other).rot, -n);
+    return -n * max(overlap - GROUND_DEPTH, 0.0);
 }
 
 // Pass "solve_joints", after every solve, once per colour of joint paths

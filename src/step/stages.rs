@@ -279,10 +279,7 @@ pub(crate) const TABLE: [StageInfo; 23] = {
             over: Over::Listed,
             poses: Poses::Flip,
             runs: Runs::InSubsteps,
-            reads: &[
-                Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds, Points, Points1,
-                Points2, Points3,
-            ],
+            reads: &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds],
             writes: &[StateOut],
             ..S::row(Stage::Solve, "solve", SOLVE_PASS, Part::Solve)
         },
