@@ -126,9 +126,9 @@ struct ManifoldPoints {
 // What one manifold asks of one of its bodies in a sweep, summed over its
 // points: a move (m; m/s in restitution) and a turn (rad; rad/s), world axes;
 // `count`: 1 if it snapped the body (solve, with SNAP_FIXED_PARTNER) or the
-// points that acted (restitution); `flags`: SNAP_PRESSED, the settling share above SETTLE_SHIFT
-// and the support share above SUPPORT_SHIFT (solve.wgsl). A manifold's two,
-// a's then b's, sit at 2 x its slot (`snap_of`). 32 bytes.
+// points that acted (restitution); `flags`: SNAP_PRESSED, the settling share
+// above SETTLE_SHIFT and the support share above SUPPORT_SHIFT (solve.wgsl).
+// A manifold's two, a's then b's, sit at 2 x its slot (`snap_of`). 32 bytes.
 struct EndSnap {
     dx: vec3<f32>,
     count: u32,
@@ -339,12 +339,6 @@ fn inv_inertia_world(q: vec4<f32>, inv_i: vec3<f32>, v: vec3<f32>) -> vec3<f32> 
 
 fn is_fixed(p: BodyProps) -> bool {
     return (p.flags & FLAG_FIXED) != 0u;
-}
-
-// Generalised inverse mass of a body for a unit push along dir at offset r.
-fn effective_inv_mass(p: BodyProps, rot: vec4<f32>, r: vec3<f32>, dir: vec3<f32>) -> f32 {
-    let rn = cross(r, dir);
-    return p.inv_inertia.w + dot(rn, inv_inertia_world(rot, p.inv_inertia.xyz, rn));
 }
 
 // One body of a contact manifold as the contact passes see it: its poses,

@@ -300,7 +300,8 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
     let other = select(m.b, m.a, is_b);
     // n from this body toward its partner
     let n = select(m.normal, -m.normal, is_b);
-    let overlap = dot(s.pos - state_of(other).pos, n) + reach_along(p, s.rot, n) + reach_along(props_of(other), state_of(other).rot, -n);
+    let o = state_of(other);
+    let overlap = dot(s.pos - o.pos, n) + reach_along(p, s.rot, n) + reach_along(props_of(other), o.rot, -n);
     return -n * max(overlap - GROUND_DEPTH, 0.0);
 }
 
