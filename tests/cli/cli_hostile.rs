@@ -156,6 +156,8 @@ fn built_in_scenes_refuse_counts_they_cannot_make() {
         (&["scene", "cubes", "--count", "0"], "--count"),
         (&["run", "--builtin", "bridge", "--count", "0", "--steps", "1"], "--count"),
         (&["bench", "--cases", "chain:0"], "--cases"),
+        (&["bench", "--cases", "chain", "--iterations", "0"], "--iterations"),
+        (&["bench", "--cases", "chain", "--iterations", "257"], "--iterations"),
     ] {
         assert_refused_quickly(args, &[wanted]);
     }

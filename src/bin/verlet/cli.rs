@@ -79,6 +79,11 @@ pub struct BenchArgs {
     /// Let bodies sleep, ours and rapier's (off by default in the bench).
     #[arg(long)]
     pub rapier_sleeping: bool,
+    /// Relaxation sweeps a step for every case of ours, as a scene's
+    /// `settings.iterations` without `substeps` (default: each case's own;
+    /// the contract suggests 8).
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_u32)]
+    pub iterations: Option<u32>,
     /// rapier's num_solver_iterations (default: rapier's own, 4).
     #[arg(long, allow_negative_numbers = true, value_parser = whole_usize)]
     pub rapier_iterations: Option<usize>,

@@ -97,6 +97,10 @@ pub fn run_case(
     let mut scene = case.scene();
     // both engines sleep, or neither (the peer's default: off)
     scene.settings.sleeping = opts.rapier_sleeping;
+    if let Some(k) = opts.iterations {
+        scene.settings.iterations = k;
+        scene.settings.substeps = verlet::Settings::substeps_for(k);
+    }
     let n = scene.bodies.len();
     let steps = steps.min((body_steps / n.max(1) as u64).max(MIN_STEPS));
     let profile_steps = profile_steps.min((body_steps / 10 / n.max(1) as u64).max(3));

@@ -108,6 +108,9 @@ pub struct Options {
     /// Let bodies sleep, ours and rapier's (off by default in the bench, so
     /// that every body is simulated every step in both).
     pub rapier_sleeping: bool,
+    /// Our relaxation sweeps a step for every case, its substeps as a scene
+    /// that gives `iterations` alone gets; `None`: each case's own.
+    pub iterations: Option<u32>,
     /// rapier's `num_solver_iterations`; `None`: rapier's default (4).
     #[cfg_attr(not(feature = "rapier"), allow(dead_code))]
     pub rapier_iterations: Option<usize>,
@@ -171,6 +174,7 @@ pub fn command(a: BenchArgs) -> Result<(), Error> {
             render: a.render || a.all,
             dispatch_cost: a.dispatch_cost || a.all,
         },
+        iterations: a.iterations,
         rapier_iterations: a.rapier_iterations,
         peer_threads: a.peer_threads,
         command: std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect::<Vec<_>>().join(" "),
@@ -201,6 +205,9 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     }
     if opts.peer_threads == Some(0) {
         return Err(Error::Input("--peer-threads: must be at least 1".into()));
+    }
+    if let Some(k) = opts.iterations.filter(|k| !(1..=verlet::scene::MAX_ITERATIONS).contains(k)) {
+        return Err(Error::Input(format!("--iterations: must be between 1 and {}, got {k}", verlet::scene::MAX_ITERATIONS)));
     }
     let cases = cases(opts)?;
     // fail on unwritable or clashing outputs before the long run, not after it

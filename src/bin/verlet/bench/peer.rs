@@ -127,11 +127,17 @@ mod rapier {
 /// The peer as the report names it, and how our iterations compare with
 /// its, in words.
 pub fn peer_description(opts: &Options, settings: &verlet::Settings) -> (String, String) {
-    let ours = format!(
-        "ours: {} Jacobi sweeps per step in {} substeps by default (each case's own in its row), contacts found once per step",
-        settings.sweeps_per_step(),
-        settings.substeps
-    );
+    let ours = match opts.iterations {
+        Some(k) => format!(
+            "ours: {k} Jacobi sweeps per step in {} substeps in every case (--iterations), contacts found once per step",
+            verlet::Settings::substeps_for(k)
+        ),
+        None => format!(
+            "ours: {} Jacobi sweeps per step in {} substeps by default (each case's own in its row), contacts found once per step",
+            settings.sweeps_per_step(),
+            settings.substeps
+        ),
+    };
     #[cfg(feature = "rapier")]
     {
         let k = opts.rapier_iterations.unwrap_or_else(|| rapier3d::prelude::IntegrationParameters::default().num_solver_iterations);
