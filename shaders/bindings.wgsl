@@ -332,17 +332,23 @@ fn contact_end(i: u32) -> ContactEnd {
         let still = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         let identity = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
         return ContactEnd(vec3<f32>(0.0), vec3<f32>(0.0), still, still, vec4<f32>(0.0), identity, mat3x3<f32>(), mat3x3<f32>(), false, false,
-                          params.ground_restitution, params.ground_friction, 0.0);
+                          params.ground_restitution, params.ground_friction, 0.0, 0.0);
     }
     let s = state_of(i);
     let p = props_of(i);
     let r = quat_to_mat(s.rot);
-    // a sphere's radius, read only for a sphere: lavapipe skips the load where no lane has one
+    // a sphere's or capsule's radius, read only for those: lavapipe skips the
+    // load where no lane has one
     var radius = 0.0;
+    var half_height = 0.0;
     if (p.shape == SHAPE_SPHERE) {
         radius = props_of(i).half_extents.x;
+    } else if (p.shape == SHAPE_CAPSULE) {
+        let h = props_of(i).half_extents;
+        radius = h.x;
+        half_height = h.y;
     }
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
                       world_inv_inertia(r, p.inv_inertia.xyz), moves_by_contacts(s, p), is_fixed(p),
-                      p.restitution, p.friction, radius);
+                      p.restitution, p.friction, radius, half_height);
 }

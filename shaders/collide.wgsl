@@ -1,6 +1,6 @@
 // Contact manifolds between boxes and spheres: the twin of
 // src/reference/collide.rs, step for step (its box_box is box_box_axis, then
-// box_box_edge or box_box_face here). A manifold's normal points from the
+// box_box_edge or box_box_face here); capsules' in capsule.wgsl. A manifold's normal points from the
 // first shape to the second; dot(on_b - on_a, n) < 0 where the shapes overlap.
 
 
@@ -12,7 +12,7 @@ const FACE_BIAS: f32 = 0.0025;
 struct Shape {
     centre: vec3<f32>,
     rot: vec4<f32>,
-    half: vec3<f32>, // box half extents; sphere: radius in x
+    half: vec3<f32>, // box half extents; sphere: radius in x; capsule: (radius, half height, radius)
     kind: u32,
 }
 
@@ -434,20 +434,31 @@ fn area_added(g: Candidates, p0: vec2<f32>, p1: vec2<f32>, p2: vec2<f32>, side: 
     return max(max(-side * cross2_to(g, p0, p1 - p0), -side * cross2_to(g, p1, p2 - p1)), -side * cross2_to(g, p2, p0 - p2));
 }
 
-// The manifold of a pair of which at least one is a sphere. A box and a
-// sphere are measured box first, in one call for either order (one copy of
-// box_sphere in the kernel), and flipped back when the sphere came first.
-fn collide_with_sphere(a: Shape, b: Shape, margin: f32) -> Manifold {
+// The manifold of a pair of which at least one is round (a sphere or a
+// capsule, capsule.wgsl). A box and a round shape are measured box first, in
+// one call for either order (one copy of each in the kernel), and flipped
+// back when the round shape came first.
+fn collide_round(a: Shape, b: Shape, margin: f32) -> Manifold {
     if (a.kind == SHAPE_SPHERE && b.kind == SHAPE_SPHERE) {
         return sphere_sphere(a.centre, a.half.x, b.centre, b.half.x, margin);
+    }
+    if (a.kind != SHAPE_BOX && b.kind != SHAPE_BOX) {
+        return round_round(swept_of(a), swept_of(b), margin);
     }
     let flip = a.kind != SHAPE_BOX;
     let box_centre = select(a.centre, b.centre, flip);
     let box_rot = select(a.rot, b.rot, flip);
     let box_half = select(a.half, b.half, flip);
-    let ball_centre = select(b.centre, a.centre, flip);
-    let ball_radius = select(b.half.x, a.half.x, flip);
-    let m = box_sphere(box_centre, box_rot, box_half, ball_centre, ball_radius, margin);
+    var round = b;
+    if (flip) {
+        round = a;
+    }
+    var m: Manifold;
+    if (round.kind == SHAPE_SPHERE) {
+        m = box_sphere(box_centre, box_rot, box_half, round.centre, round.half.x, margin);
+    } else {
+        m = box_capsule(box_centre, box_rot, box_half, swept_of(round), margin);
+    }
     if (flip) {
         return flip_manifold(m);
     }

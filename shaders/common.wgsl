@@ -207,10 +207,14 @@ struct JointRef {
     body: u32,               // the body at this end
 }
 
-// Half extents of a body's world box: |R| h for a box, the radius for a sphere.
+// Half extents of a body's world box: |R| h for a box, the radius for a
+// sphere, a capsule's segment's |R| h plus its radius.
 fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(p.half_extents.x);
+    }
+    if (p.shape == SHAPE_CAPSULE) {
+        return abs(quat_rotate(s.rot, vec3<f32>(0.0, p.half_extents.y, 0.0))) + p.half_extents.x;
     }
     let q = s.rot;
     let x = quat_rotate(q, vec3<f32>(p.half_extents.x, 0.0, 0.0));
@@ -223,6 +227,9 @@ fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
 fn reach_along(p: BodyProps, rot: vec4<f32>, dir: vec3<f32>) -> f32 {
     if (p.shape == SHAPE_SPHERE) {
         return p.half_extents.x;
+    }
+    if (p.shape == SHAPE_CAPSULE) {
+        return abs(quat_rotate(quat_conj(rot), dir).y) * p.half_extents.y + p.half_extents.x;
     }
     return dot(abs(quat_rotate(quat_conj(rot), dir)), p.half_extents.xyz);
 }
@@ -356,16 +363,22 @@ struct ContactEnd {
     fixed: bool,            // a fixed body (not the ground)
     restitution: f32,
     friction: f32,
-    radius: f32,            // a sphere's radius (m); 0 for a box or the ground
+    radius: f32,            // a sphere's or capsule's radius (m); 0 for a box or the ground
+    half_height: f32,       // a capsule's half height (m); else 0
 }
 
 // The point of an end a contact of normal `toward` (from the end to its
 // partner) measures, in the end's frame: the stored point, or for a sphere the
 // point of its surface that faces the partner now (a fast roll turns the
-// stored material point away, and the ball sank through the ground).
+// stored material point away, and the ball sank through the ground); for a
+// capsule, that of the ball at the stored point's place along its segment.
 fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
     if (e.radius > 0.0) {
-        return (toward * e.radius) * e.rot_m; // R^T (toward r)
+        let surface = (toward * e.radius) * e.rot_m; // R^T (toward r)
+        if (e.half_height > 0.0) {
+            return surface + vec3<f32>(0.0, clamp(stored.y, -e.half_height, e.half_height), 0.0);
+        }
+        return surface;
     }
     return stored;
 }

@@ -62,6 +62,17 @@ fn shape_inv_inertia(p: BodyProps, m: f32) -> vec3<f32> {
     if (p.shape == SHAPE_SPHERE) {
         return vec3<f32>(1.0 / (0.4 * m * h.x * h.x));
     }
+    if (p.shape == SHAPE_CAPSULE) {
+        // as Shape::inertia_f64: the cylinder, and the caps as one ball
+        let r = h.x;
+        let cylinder = 2.0 * h.y;
+        let ball = 4.0 / 3.0 * r;
+        let mc = m * cylinder / (cylinder + ball);
+        let ms = m * ball / (cylinder + ball);
+        let across = mc * (r * r / 4.0 + h.y * h.y / 3.0) + ms * (0.4 * r * r + h.y * h.y + 0.75 * h.y * r);
+        let along = mc * r * r / 2.0 + ms * 0.4 * r * r;
+        return vec3<f32>(1.0 / across, 1.0 / along, 1.0 / across);
+    }
     let q = h * h;
     return vec3<f32>(3.0 / (m * (q.y + q.z)), 3.0 / (m * (q.x + q.z)), 3.0 / (m * (q.x + q.y)));
 }
@@ -238,6 +249,12 @@ fn projected_area(p: BodyProps, rot: vec4<f32>, u: vec3<f32>) -> f32 {
     let h = p.half_extents.xyz;
     if (p.shape == SHAPE_SPHERE) {
         return 3.14159265 * h.x * h.x;
+    }
+    if (p.shape == SHAPE_CAPSULE) {
+        // a disc, and the segment's shadow swept by the radius
+        let along = quat_rotate(rot, vec3<f32>(0.0, 1.0, 0.0));
+        let c = dot(along, u);
+        return 3.14159265 * h.x * h.x + 4.0 * h.x * h.y * sqrt(max(1.0 - c * c, 0.0));
     }
     let l = abs(quat_rotate(quat_conj(rot), u));
     return 4.0 * (h.y * h.z * l.x + h.x * h.z * l.y + h.x * h.y * l.z);

@@ -18,7 +18,8 @@ fn world_to_local(i: u32, p: vec3<f32>) -> vec3<f32> {
 }
 
 // Body i against the ground within `margin`, normal from the body down: a
-// sphere's lowest point, or the deepest four box corners within the margin.
+// sphere's lowest point, a capsule's under each end of its segment, or the
+// deepest four box corners within the margin.
 fn ground_manifold(i: u32, margin: f32) -> Manifold {
     let s = state_of(i);
     let p = props_of(i);
@@ -33,6 +34,9 @@ fn ground_manifold(i: u32, margin: f32) -> Manifold {
             m.on_b[0] = vec3<f32>(lowest.x, ground, lowest.z);
         }
         return m;
+    }
+    if (p.shape == SHAPE_CAPSULE) {
+        return ground_capsule(swept_of(shape_of(i)), ground, margin);
     }
     // heights of the eight corners above the ground
     var height: array<f32, 8>;
@@ -178,7 +182,7 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (boxes) {
         axis = box_box_axis(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
     } else {
-        m = collide_with_sphere(a, b, margin);
+        m = collide_round(a, b, margin);
     }
     let touches = select(m.count > 0u, axis.kind != AXIS_APART, boxes);
     let to_clip = boxes && axis.kind == AXIS_FACE;

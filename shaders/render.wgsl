@@ -33,15 +33,16 @@ struct Globals {
 }
 
 // One drawn body (32 bytes); `RenderBody` in src/render/gpu.rs. Boxes come
-// first, then spheres, so each mesh is one instanced draw over a range.
+// first, then spheres and capsules (both drawn from the sphere's mesh), so
+// each mesh is one instanced draw over a range.
 struct RenderBody {
-    // box: half extents (m); sphere: the radius in all three
+    // box: half extents (m); sphere: the radius in all three; capsule: (radius, half height, radius)
     half_extents: vec3<f32>,
     // index of the body in the state buffer
     body: u32,
     // linear RGB
     color: vec3<f32>,
-    // SHAPE_BOX or SHAPE_SPHERE
+    // SHAPE_BOX, SHAPE_SPHERE or SHAPE_CAPSULE
     shape: u32,
 }
 
@@ -99,7 +100,17 @@ fn shade(albedo: vec3<f32>, n: vec3<f32>, world_pos: vec3<f32>) -> vec3<f32> {
 fn body_point(mesh_pos: vec3<f32>, b: RenderBody) -> vec3<f32> {
     let s = states[b.body];
     // the state's quaternion drifts from unit length by rounding only; renormalise anyway
-    return s.pos + quat_rotate(normalize(s.rot), mesh_pos * b.half_extents);
+    return s.pos + quat_rotate(normalize(s.rot), mesh_local(mesh_pos, b));
+}
+
+// A unit mesh point in the body's frame: scaled to a box or a sphere; a
+// capsule is the sphere's halves moved half its height apart along y.
+fn mesh_local(mesh_pos: vec3<f32>, b: RenderBody) -> vec3<f32> {
+    if b.shape == SHAPE_CAPSULE {
+        let r = b.half_extents.x;
+        return mesh_pos * r + vec3<f32>(0.0, select(-b.half_extents.y, b.half_extents.y, mesh_pos.y >= 0.0), 0.0);
+    }
+    return mesh_pos * b.half_extents;
 }
 
 // The bodies as the sun sees them: depth only, into the shadow map.
@@ -128,12 +139,13 @@ fn body_vertex(
     let b = bodies[slot];
     let q = normalize(states[b.body].rot);
     // unit mesh scaled to the body's size, in the body's frame
-    let local = mesh_pos * b.half_extents;
+    let local = mesh_local(mesh_pos, b);
     let world = body_point(mesh_pos, b);
     var out: BodyOut;
     out.clip = globals.view_proj * vec4<f32>(world, 1.0);
     out.world_pos = world;
-    // a box's face normals and a sphere's normals survive its (axis-aligned or uniform) scale
+    // a box's face normals and a sphere's normals survive its (axis-aligned or
+    // uniform) scale; a capsule's halves keep theirs, and its sides go between
     out.world_normal = quat_rotate(q, mesh_normal);
     out.local_pos = local;
     out.half_extents = b.half_extents;
@@ -151,11 +163,11 @@ fn body_fragment(in: BodyOut) -> @location(0) vec4<f32> {
     // a darker band about a pixel wide along every edge, so faces read apart (uniform control flow)
     let px = fwidth(middle);
     let edge = 1.0 - smoothstep(0.5 * px, 1.5 * px, middle);
-    // sphere: two tones by octant of the body frame, so a spin shows
+    // sphere or capsule: two tones by octant of the body frame, so a spin shows
     let l = in.local_pos;
     let octant = select(0.0, 1.0, l.x * l.y * l.z < 0.0);
     var albedo = in.color;
-    if in.shape == SHAPE_SPHERE {
+    if in.shape != SHAPE_BOX {
         albedo = mix(albedo, vec3<f32>(1.0), 0.5 * octant);
     } else {
         albedo = albedo * (1.0 - 0.5 * edge);

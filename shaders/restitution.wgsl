@@ -92,6 +92,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     var bounce_moment_b = vec3<f32>(0.0);
     var bounce_inv_w = 0.0;
     var acting = 0u;
+    var rubbing = 0u;
     for (var q = 0u; q < count; q = q + 1u) {
         let pt = point_of(at, q);
         set_pushed(at, q, 0.0);
@@ -119,6 +120,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
             let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
             let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / w_t);
             impulse = impulse + t * j;
+            rubbing = rubbing + 1u;
             acted = true;
         }
         // restitution of a fast approach (approach < 0: closing), along a's push -n
@@ -139,6 +141,12 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
             bounce_moment_b = bounce_moment_b + cross(rb, bounce);
             acting = acting + 1u;
         }
+    }
+    // a capsule's points lie along the axis it turns freely about: their
+    // friction's pushes are averaged, as their turns are (`restituted`), and
+    // as in the solve
+    if (ea.half_height > 0.0 || eb.half_height > 0.0) {
+        j = j / f32(max(rubbing, 1u));
     }
     // Each point's bounce is computed as if it alone turned the approach
     // around, so the sum is scaled down to what moving the two bodies apart

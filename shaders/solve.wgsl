@@ -95,6 +95,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     var normal_inv_w = 0.0;
     var friction_inv_w = 0.0;
     var points = 0u;
+    var rubbed = 0u;
     var pressed = 0u;
         // depths summed: old overlap that settles, old overlap that supports, all
     var old_depth = 0.0;
@@ -151,6 +152,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
                 moment_a = moment_a + cross(ra, j);
                 moment_b = moment_b + cross(rb, j);
                 friction_inv_w = friction_inv_w + 1.0 / w;
+                rubbed = rubbed + 1u;
                 snapped = true;
             }
         }
@@ -171,7 +173,13 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         pair_w_split = pair_w_split + eb.inv_inertia.w * split_b.y;
     }
     let n_scale = min(1.0, 1.0 / max(pair_w_split * normal_inv_w, 1e-30));
-    let f_scale = min(1.0, 1.0 / max(pair_w * friction_inv_w, 1e-30));
+    var f_scale = min(1.0, 1.0 / max(pair_w * friction_inv_w, 1e-30));
+    // a capsule turns freely about its axis, and its points lie along it, so
+    // their friction turns it as one point's does (the turns are averaged):
+    // their pushes are averaged too, or a rolling capsule is held back
+    if (ea.half_height > 0.0 || eb.half_height > 0.0) {
+        f_scale = min(f_scale, 1.0 / f32(max(rubbed, 1u)));
+    }
     let j = normal_j * n_scale + friction_j * f_scale;
     let turns = 1.0 / f32(max(points, 1u));
     let touched = u32(points > 0u);

@@ -47,13 +47,14 @@ pub const WAKES: u32 = 0x4000_0000;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BodyProps {
-    /// Box: half extents (m); sphere: radius in x. w = bounding radius (m).
+    /// Box: half extents (m); sphere: radius in x; capsule: (radius, half
+    /// height, radius). w = bounding radius (m).
     pub half_extents: [f32; 4],
     /// xyz = body-frame principal inverse inertia (1/(kg m^2)); w = inverse mass (1/kg).
     pub inv_inertia: [f32; 4],
     pub restitution: f32,
     pub friction: f32,
-    /// `SHAPE_BOX` or `SHAPE_SPHERE`.
+    /// `SHAPE_BOX`, `SHAPE_SPHERE` or `SHAPE_CAPSULE`.
     pub shape: u32,
     /// `FLAG_*` bits.
     pub flags: u32,
@@ -299,6 +300,8 @@ pub const SCAN_SPAN: u32 = SCAN_BLOCK * SCAN_RUN;
 /// `BodyProps::shape`.
 pub const SHAPE_BOX: u32 = 0;
 pub const SHAPE_SPHERE: u32 = 1;
+/// A capsule: `half_extents` holds (radius, half height, radius).
+pub const SHAPE_CAPSULE: u32 = 2;
 /// `BodyProps::flags` bit: the body never moves.
 pub const FLAG_FIXED: u32 = 1;
 /// `BodyProps::grid_class` of a body in the broadphase grid, and of one too

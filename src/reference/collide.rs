@@ -1,5 +1,6 @@
 //! Narrowphase reference (twin of `shaders/collide.wgsl`): contact
-//! manifolds between boxes and spheres.
+//! manifolds between boxes and spheres, and the capsules' (`capsule.rs`)
+//! by the same rules.
 //!
 //! A manifold has one normal `n`, pointing from the first shape to the
 //! second, and up to `MAX_POINTS` pairs of points (`on_a`, `on_b`) in world
@@ -10,10 +11,13 @@
 
 use glam::{Mat3, Quat, Vec2, Vec3};
 
+use super::capsule::{box_capsule, round_round, Swept};
+use crate::scene::Shape;
+
 /// Points kept per pair: the clipped polygon (up to 8) is reduced to 4.
 pub const MAX_POINTS: usize = 4;
 
-/// A box or sphere placed in the world.
+/// A box, sphere or capsule placed in the world.
 #[derive(Clone, Copy, Debug)]
 pub struct Placed {
     pub centre: Vec3,
@@ -25,6 +29,28 @@ pub struct Placed {
 pub enum ShapeKind {
     Box(Vec3),
     Sphere(f32),
+    Capsule { radius: f32, half_height: f32 },
+}
+
+impl From<&Shape> for ShapeKind {
+    fn from(shape: &Shape) -> ShapeKind {
+        match *shape {
+            Shape::Box { half_extents } => ShapeKind::Box(Vec3::from(half_extents)),
+            Shape::Sphere { radius } => ShapeKind::Sphere(radius),
+            Shape::Capsule { radius, half_height } => ShapeKind::Capsule { radius, half_height },
+        }
+    }
+}
+
+impl Placed {
+    /// A round shape as a segment swept by its radius; None for a box.
+    fn swept(&self) -> Option<Swept> {
+        match self.shape {
+            ShapeKind::Box(_) => None,
+            ShapeKind::Sphere(r) => Some(Swept::sphere(self.centre, r)),
+            ShapeKind::Capsule { radius, half_height } => Some(Swept::capsule(self.centre, self.rot, radius, half_height)),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,6 +93,9 @@ pub fn collide(a: &Placed, b: &Placed, margin: f32) -> Option<Manifold> {
         (ShapeKind::Box(h), ShapeKind::Sphere(r)) => box_sphere(a.centre, a.rot, h, b.centre, r, margin),
         (ShapeKind::Sphere(r), ShapeKind::Box(h)) => box_sphere(b.centre, b.rot, h, a.centre, r, margin).map(|m| flip(&m)),
         (ShapeKind::Box(ha), ShapeKind::Box(hb)) => box_box(a.centre, a.rot, ha, b.centre, b.rot, hb, margin),
+        (ShapeKind::Box(h), ShapeKind::Capsule { .. }) => box_capsule(a.centre, a.rot, h, &b.swept()?, margin),
+        (ShapeKind::Capsule { .. }, ShapeKind::Box(h)) => box_capsule(b.centre, b.rot, h, &a.swept()?, margin).map(|m| flip(&m)),
+        (ShapeKind::Capsule { .. }, _) | (_, ShapeKind::Capsule { .. }) => round_round(&a.swept()?, &b.swept()?, margin),
     }
 }
 
@@ -290,7 +319,7 @@ fn overlap_corners(corners: [Vec2; 4], half: Vec2, winding: f32) -> Vec<Vec2> {
 }
 
 /// Closest points of two segments, each given by centre, unit direction and half length.
-fn closest_on_edges(pa: Vec3, da: Vec3, la: f32, pb: Vec3, db: Vec3, lb: f32) -> (Vec3, Vec3) {
+pub(crate) fn closest_on_edges(pa: Vec3, da: Vec3, la: f32, pb: Vec3, db: Vec3, lb: f32) -> (Vec3, Vec3) {
     let r = pb - pa;
     let b = da.dot(db);
     let denom = 1.0 - b * b;

@@ -5,7 +5,7 @@
 //! `Renderer::set_body_color` rewrites a record).
 
 use super::gpu::{JointLine, RenderBody};
-use crate::gpu::types::{SHAPE_BOX, SHAPE_SPHERE};
+use crate::gpu::types::{SHAPE_BOX, SHAPE_CAPSULE, SHAPE_SPHERE};
 use crate::scene::{Scene, Shape};
 
 /// Background (sRGB): a pale sky; the ground fades into it.
@@ -13,13 +13,14 @@ pub(super) const BACKGROUND_SRGB: [f32; 3] = [0.80, 0.85, 0.90];
 /// Colour of fixed bodies (sRGB): a neutral grey, the colour of "not moving".
 const FIXED_SRGB: [f32; 3] = [0.55, 0.55, 0.55];
 
-/// The bodies as drawn: one instance each, boxes first, then spheres, so
-/// that each mesh is one instanced draw.
+/// The bodies as drawn: one instance each, boxes first, then spheres and
+/// capsules, so that each mesh (a capsule is the sphere's, stretched) is
+/// one instanced draw.
 pub(super) struct Instances {
-    /// In draw order: the boxes' slots, then the spheres'.
+    /// In draw order: the boxes' slots, then the spheres' and capsules'.
     pub(super) bodies: Vec<RenderBody>,
     pub(super) box_count: u32,
-    pub(super) sphere_count: u32,
+    pub(super) round_count: u32,
     /// Each body's slot in `bodies`, by its index in the scene.
     pub(super) slot_of_body: Vec<u32>,
 }
@@ -27,25 +28,26 @@ pub(super) struct Instances {
 impl Instances {
     pub(super) fn new(scene: &Scene) -> Instances {
         let mut instances = Vec::with_capacity(scene.bodies.len());
-        for want in [SHAPE_BOX, SHAPE_SPHERE] {
+        for round in [false, true] {
             for (i, b) in scene.bodies.iter().enumerate() {
                 let (half_extents, shape) = match b.shape {
                     Shape::Box { half_extents } => (half_extents, SHAPE_BOX),
                     Shape::Sphere { radius } => ([radius; 3], SHAPE_SPHERE),
+                    Shape::Capsule { radius, half_height } => ([radius, half_height, radius], SHAPE_CAPSULE),
                 };
-                if shape == want {
+                if (shape != SHAPE_BOX) == round {
                     let srgb = if b.fixed { FIXED_SRGB } else { body_color(i) };
                     instances.push(RenderBody { half_extents, body: i as u32, color: srgb.map(srgb_to_linear), shape });
                 }
             }
         }
         let box_count = instances.iter().filter(|r| r.shape == SHAPE_BOX).count() as u32;
-        let sphere_count = instances.len() as u32 - box_count;
+        let round_count = instances.len() as u32 - box_count;
         let mut slot_of_body = vec![0u32; scene.bodies.len()];
         for (slot, r) in instances.iter().enumerate() {
             slot_of_body[r.body as usize] = slot as u32;
         }
-        Instances { bodies: instances, box_count, sphere_count, slot_of_body }
+        Instances { bodies: instances, box_count, round_count, slot_of_body }
     }
 }
 

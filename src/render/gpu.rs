@@ -58,13 +58,14 @@ pub struct Globals {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RenderBody {
-    /// Box: half extents (m); sphere: the radius three times.
+    /// Box: half extents (m); sphere: the radius three times; capsule:
+    /// (radius, half height, radius).
     pub half_extents: [f32; 3],
     /// Index of the body in the state buffer.
     pub body: u32,
     /// Linear RGB.
     pub color: [f32; 3],
-    /// `SHAPE_BOX` or `SHAPE_SPHERE`.
+    /// `SHAPE_BOX`, `SHAPE_SPHERE` or `SHAPE_CAPSULE`.
     pub shape: u32,
 }
 
@@ -242,7 +243,7 @@ impl RenderPipelines {
 /// The renderer's buffers and textures, all made once at start-up.
 pub(crate) struct RenderData {
     pub globals: wgpu::Buffer,
-    /// `RenderBody` per body, boxes first, then spheres.
+    /// `RenderBody` per body, boxes first, then spheres and capsules.
     pub bodies: wgpu::Buffer,
     pub joints: wgpu::Buffer,
     /// The unit cube (36 vertices), then the unit icosphere.
@@ -274,7 +275,7 @@ pub(super) struct Canvas {
     width: u32,
     height: u32,
     box_count: u32,
-    sphere_count: u32,
+    round_count: u32,
     sphere_vertices: u32,
     joint_count: u32,
     /// Bind groups by the state buffer they bind (a world alternates two).
@@ -391,7 +392,7 @@ impl Canvas {
             width,
             height,
             box_count: instances.box_count,
-            sphere_count: instances.sphere_count,
+            round_count: instances.round_count,
             sphere_vertices,
             joint_count: joints.len() as u32,
             bind_groups: Vec::new(),
@@ -517,13 +518,13 @@ impl Canvas {
         RgbaImage::from_raw(self.width, self.height, pixels).ok_or_else(|| gpu_err("render: readback has the wrong size".into()))
     }
 
-    /// One instanced draw per mesh: the boxes' slots, then the spheres'.
+    /// One instanced draw per mesh: the boxes' slots, then the spheres' and capsules'.
     fn draw_bodies(&self, pass: &mut wgpu::RenderPass) {
         if self.box_count > 0 {
             pass.draw(0..36, 0..self.box_count);
         }
-        if self.sphere_count > 0 {
-            pass.draw(36..36 + self.sphere_vertices, self.box_count..self.box_count + self.sphere_count);
+        if self.round_count > 0 {
+            pass.draw(36..36 + self.sphere_vertices, self.box_count..self.box_count + self.round_count);
         }
     }
 

@@ -89,6 +89,7 @@ pub(super) struct RawShape {
     kind: Option<String>,
     half_extents: Option<Vec<f32>>,
     radius: Option<f32>,
+    half_height: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -239,6 +240,7 @@ impl RawShape {
                         format!("is not used by a box (got {}); a box takes half_extents", show(radius)),
                     ));
                 }
+                refuse_half_height(self.half_height, path, "a box takes half_extents")?;
                 let he_path = format!("{path}.half_extents");
                 let half_extents = exact(self.half_extents.ok_or_else(|| SceneError::missing(&he_path))?, &he_path)?;
                 Ok(Shape::Box { half_extents })
@@ -250,11 +252,36 @@ impl RawShape {
                         "is not used by a sphere; a sphere takes radius",
                     ));
                 }
+                refuse_half_height(self.half_height, path, "a sphere takes radius")?;
                 let radius = self.radius.ok_or_else(|| SceneError::missing(format!("{path}.radius")))?;
                 Ok(Shape::Sphere { radius })
             }
-            other => Err(SceneError::invalid(type_path, format!("unknown shape type {other:?}, expected \"box\" or \"sphere\""))),
+            "capsule" => {
+                if self.half_extents.is_some() {
+                    return Err(SceneError::invalid(
+                        format!("{path}.half_extents"),
+                        "is not used by a capsule; a capsule takes radius and half_height",
+                    ));
+                }
+                let radius = self.radius.ok_or_else(|| SceneError::missing(format!("{path}.radius")))?;
+                let half_height = self.half_height.ok_or_else(|| SceneError::missing(format!("{path}.half_height")))?;
+                Ok(Shape::Capsule { radius, half_height })
+            }
+            other => Err(SceneError::invalid(
+                type_path,
+                format!("unknown shape type {other:?}, expected \"box\", \"sphere\" or \"capsule\""),
+            )),
         }
+    }
+}
+
+/// Refuses `half_height` on a shape other than a capsule.
+fn refuse_half_height(half_height: Option<f32>, path: &str, takes: &str) -> Result<(), SceneError> {
+    match half_height {
+        Some(h) => {
+            Err(SceneError::invalid(format!("{path}.half_height"), format!("is only used by a capsule (got {}); {takes}", show(h))))
+        }
+        None => Ok(()),
     }
 }
 

@@ -201,14 +201,18 @@ pub struct Ground {
 /// The collision and mass shape of a body, in the body's local frame and
 /// centred on its centre of mass.
 ///
-/// In JSON: `{"type": "box", "half_extents": [x, y, z]}` or
-/// `{"type": "sphere", "radius": r}`.
+/// In JSON: `{"type": "box", "half_extents": [x, y, z]}`,
+/// `{"type": "sphere", "radius": r}` or
+/// `{"type": "capsule", "radius": r, "half_height": h}`.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
     /// A box with the given half extents in metres (all > 0).
     Box { half_extents: [f32; 3] },
     /// A sphere with the given radius in metres (> 0).
     Sphere { radius: f32 },
+    /// The segment from (0, -half_height, 0) to (0, half_height, 0) swept by
+    /// `radius` (metres, both > 0): a cylinder capped by two half spheres.
+    Capsule { radius: f32, half_height: f32 },
 }
 
 impl Shape {
@@ -224,6 +228,10 @@ impl Shape {
                 let r = radius as f64;
                 4.0 / 3.0 * std::f64::consts::PI * r * r * r
             }
+            Shape::Capsule { radius, half_height } => {
+                let (r, h) = (radius as f64, half_height as f64);
+                std::f64::consts::PI * r * r * (2.0 * h + 4.0 / 3.0 * r)
+            }
         }
     }
 
@@ -236,6 +244,7 @@ impl Shape {
                 (a * a + b * b + c * c).sqrt() as f32
             }
             Shape::Sphere { radius } => radius,
+            Shape::Capsule { radius, half_height } => radius + half_height,
         }
     }
 
@@ -251,6 +260,17 @@ impl Shape {
             Shape::Sphere { radius } => {
                 let i = 0.4 * m * (radius as f64).powi(2);
                 [i, i, i]
+            }
+            Shape::Capsule { radius, half_height } => {
+                // the cylinder, and the two caps as one ball whose halves sit
+                // half_height from the centre (their centroids 3r/8 further)
+                let (r, h) = (radius as f64, half_height as f64);
+                let cylinder = 2.0 * h;
+                let ball = 4.0 / 3.0 * r;
+                let (mc, ms) = (m * cylinder / (cylinder + ball), m * ball / (cylinder + ball));
+                let across = mc * (r * r / 4.0 + h * h / 3.0) + ms * (0.4 * r * r + h * h + 0.75 * h * r);
+                let along = mc * r * r / 2.0 + ms * 0.4 * r * r;
+                [across, along, across]
             }
         }
     }

@@ -342,6 +342,11 @@ pub(super) fn check_shape(shape: &Shape, path: &str) -> Result<(), SceneError> {
             check_positive(radius, &format!("{path}.radius"))?;
             "radius"
         }
+        Shape::Capsule { radius, half_height } => {
+            check_positive(radius, &format!("{path}.radius"))?;
+            check_positive(half_height, &format!("{path}.half_height"))?;
+            "radius"
+        }
     };
     let r = shape.bounding_radius();
     if r < MIN_BOUNDING_RADIUS {

@@ -60,6 +60,9 @@ pub(super) fn body_json(body: &Body) -> String {
         Shape::Sphere { radius } => {
             format!("{{ \"type\": \"sphere\", \"radius\": {} }}", num(radius))
         }
+        Shape::Capsule { radius, half_height } => {
+            format!("{{ \"type\": \"capsule\", \"radius\": {}, \"half_height\": {} }}", num(radius), num(half_height))
+        }
     };
     let mut fields = vec![
         ("shape", shape),

@@ -439,6 +439,7 @@ pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
     let (half, shape) = match b.shape {
         Shape::Box { half_extents: h } => ([h[0], h[1], h[2]], SHAPE_BOX),
         Shape::Sphere { radius } => ([radius, radius, radius], SHAPE_SPHERE),
+        Shape::Capsule { radius, half_height } => ([radius, half_height, radius], SHAPE_CAPSULE),
     };
     let ii = b.inverse_inertia();
     BodyProps {

@@ -209,7 +209,8 @@ fn cell_bounds_hold_a_sleepers_moves() {
 /// (grid.wgsl's reach_of and spin_reach_of): its centre by its last
 /// displacement, rescaled to the step, plus gravity's part; its points by
 /// that plus its turn's part, 2 |q - q_prev| R a substep (the nearer of q
-/// and -q), none for a sphere. PairMeta's reach, spin, bound (the bounding
+/// and -q), none for a sphere. A capsule's world box is its segment's plus
+/// its radius. PairMeta's reach, spin, bound (the bounding
 /// radius grown by the centre's move alone) and extent (the world box grown
 /// by all of it), against the same sums on the CPU.
 #[test]
@@ -226,6 +227,10 @@ fn grid_count_bounds_each_body_by_its_move_and_turn() {
     ball.angular_velocity = [0.0, 0.0, 20.0];
     ball.linear_velocity = [0.0, -3.0, 0.0];
     bodies.push(ball);
+    let mut capsule = verlet::Body::new(verlet::Shape::Capsule { radius: 0.2, half_height: 0.6 }, [-3.0, 5.0, 0.0]);
+    capsule.orientation = Quat::from_rotation_z(0.7).to_array();
+    capsule.angular_velocity = [2.0, 0.0, 5.0];
+    bodies.push(capsule);
     let scene = Scene { settings: Settings::default(), ground: None, bodies, joints: vec![], camera: None };
     let Some(mut w) = world(&scene) else { return };
     w.run_stages(&[Stage::GridCount]).unwrap();
@@ -243,7 +248,7 @@ fn grid_count_bounds_each_body_by_its_move_and_turn() {
         let turned = (q - prev).length().min((q + prev).length());
         let spin = match body.shape {
             verlet::Shape::Sphere { .. } => 0.0,
-            verlet::Shape::Box { .. } => 2.0 * turned * radius * steps,
+            verlet::Shape::Box { .. } | verlet::Shape::Capsule { .. } => 2.0 * turned * radius * steps,
         };
         let world_box = match body.shape {
             verlet::Shape::Sphere { radius } => Vec3::splat(radius),
@@ -251,6 +256,10 @@ fn grid_count_bounds_each_body_by_its_move_and_turn() {
                 let r = glam::Mat3::from_quat(Quat::from_array(s.rot));
                 let h = Vec3::from(half_extents);
                 r.x_axis.abs() * h.x + r.y_axis.abs() * h.y + r.z_axis.abs() * h.z
+            }
+            verlet::Shape::Capsule { radius, half_height } => {
+                let r = glam::Mat3::from_quat(Quat::from_array(s.rot));
+                r.y_axis.abs() * half_height + Vec3::splat(radius)
             }
         };
         let m = &meta[i];

@@ -8,11 +8,7 @@ use verlet::scenes::{self, box_body};
 use verlet::{BodyOutput, Scene, Shape};
 
 fn placed(scene: &Scene, i: usize, s: &BodyOutput) -> Placed {
-    let shape = match scene.bodies[i].shape {
-        Shape::Box { half_extents } => ShapeKind::Box(Vec3::from(half_extents)),
-        Shape::Sphere { radius } => ShapeKind::Sphere(radius),
-    };
-    Placed { centre: v3(s.position), rot: quat(s.orientation), shape }
+    Placed { centre: v3(s.position), rot: quat(s.orientation), shape: ShapeKind::from(&scene.bodies[i].shape) }
 }
 
 /// Deepest overlap between any two bodies (m), by the CPU reference.
@@ -50,6 +46,7 @@ fn lowest_corner(scene: &Scene, i: usize, s: &BodyOutput) -> f32 {
     match scene.bodies[i].shape {
         Shape::Box { half_extents: h } => corners(h, s).map(|c| c.y).fold(f32::MAX, f32::min),
         Shape::Sphere { radius } => s.position[1] - radius,
+        Shape::Capsule { radius, half_height } => s.position[1] - (quat(s.orientation) * Vec3::Y).y.abs() * half_height - radius,
     }
 }
 

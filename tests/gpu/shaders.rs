@@ -93,6 +93,7 @@ fn every_loop_counts_to_a_bound() {
         ("grid.wgsl", shaders::GRID.to_string()),
         ("pairs.wgsl", shaders::PAIRS.to_string()),
         ("collide.wgsl", shaders::COLLIDE.to_string()),
+        ("capsule.wgsl", shaders::CAPSULE.to_string()),
         ("narrowphase.wgsl", shaders::NARROWPHASE.to_string()),
         ("integrate.wgsl", shaders::INTEGRATE.to_string()),
         ("solve.wgsl", shaders::SOLVE.to_string()),

@@ -85,6 +85,7 @@ mod rapier {
                 let shape = match b.shape {
                     Shape::Box { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
                     Shape::Sphere { radius } => ColliderBuilder::ball(radius),
+                    Shape::Capsule { radius, half_height } => ColliderBuilder::capsule_y(half_height, radius),
                 };
                 let collider =
                     material(shape.mass(b.mass), b.friction.unwrap_or(s.friction), b.restitution.unwrap_or(s.restitution));
