@@ -101,6 +101,7 @@ fn box_capsule(cb: vec3<f32>, rot: vec4<f32>, h: vec3<f32>, capsule: Swept, marg
     let d = quat_rotate(to_local, capsule.dir);
     let l = capsule.half_length;
     let r = capsule.radius;
+    let local = Swept(c, d, l, r);
     // the box's face axes
     let face_sep = abs(c) - h - abs(d) * l;
     let face = select(select(2u, 1u, face_sep.y >= face_sep.z), 0u, face_sep.x >= face_sep.y && face_sep.x >= face_sep.z);
@@ -128,26 +129,31 @@ fn box_capsule(cb: vec3<f32>, rot: vec4<f32>, h: vec3<f32>, capsule: Swept, marg
     let on_box = clamp(on_seg, -h, h);
     let out = on_seg - on_box;
     let dist = length(out);
-    var n = vec3<f32>(0.0, 1.0, 0.0);
-    if (worst > 0.0 && dist > 1e-6) {
-        if (dist - r > margin) {
-            return m;
-        }
-        n = out / dist;
-        let an = abs(n);
-        let k = select(select(2u, 1u, an.y >= an.z), 0u, an.x >= an.y && an.x >= an.z);
-        let s = sign_of(component(n, k));
-        if (component(an, k) >= FACE_ALIGNED) {
-            m = face_points(c, d, l, r, h, k, s, margin);
-        }
-        if (m.count == 0u) {
-            m.count = 1u;
-            m.on_a[0] = on_box;
-            m.on_b[0] = on_seg - n * r;
-        } else {
-            n = unit(k) * s;
-        }
-    } else if (best_edge_sep > best_face_sep + EDGE_BIAS) {
+    let misses = worst > 0.0 && dist > 1e-6;
+    if (misses && dist - r > margin) {
+        return m;
+    }
+    // the face the capsule may lie on (one call of face_points in the kernel):
+    // where it misses the box, the face its nearest point looks out of, if
+    // nearly square to it; else the face of least overlap, unless an edge's
+    var n = out / dist;
+    let an = abs(n);
+    let near_face = select(select(2u, 1u, an.y >= an.z), 0u, an.x >= an.y && an.x >= an.z);
+    let k = select(face, near_face, misses);
+    let s = select(sign_of(component(c, face)), sign_of(component(n, near_face)), misses);
+    let edge = !misses && best_edge_sep > best_face_sep + EDGE_BIAS;
+    if ((misses && component(an, near_face) >= FACE_ALIGNED) || (!misses && !edge)) {
+        m = face_points(local, h, k, s, margin);
+    }
+    if (m.count > 0u || !misses) {
+        n = unit(k) * s;
+    }
+    if (misses && m.count == 0u) {
+        m.count = 1u;
+        m.on_a[0] = on_box;
+        m.on_b[0] = on_seg - n * r;
+    }
+    if (edge) {
         // the segment passes into the box across an edge: that edge, farthest along n
         n = best_edge_l;
         let edge_centre = h * vec3<f32>(sign_of(n.x), sign_of(n.y), sign_of(n.z)) * (vec3<f32>(1.0) - unit(best_edge));
@@ -157,10 +163,6 @@ fn box_capsule(cb: vec3<f32>, rot: vec4<f32>, h: vec3<f32>, capsule: Swept, marg
         m.count = 1u;
         m.on_a[0] = on_edge;
         m.on_b[0] = on_segment - n * r;
-    } else {
-        let s = sign_of(component(c, face));
-        n = unit(face) * s;
-        m = face_points(c, d, l, r, h, face, s, margin);
     }
     // back to the world
     m.normal = quat_rotate(rot, n);
@@ -205,13 +207,15 @@ fn box_distance2(p: vec3<f32>, h: vec3<f32>) -> f32 {
     return dot(out, out);
 }
 
-// The capsule against face k (outward sign s) of the box, in the box's frame:
+// The capsule (`local`: in the box's frame) against face k (outward sign s) of the box:
 // its segment clipped to the face's sides, each end of what is left a point (on
 // the face, on the capsule) if within the margin; the normal is left to the caller.
-fn face_points(c: vec3<f32>, d: vec3<f32>, l: f32, r: f32, h: vec3<f32>, k: u32, s: f32, margin: f32) -> Manifold {
+fn face_points(local: Swept, h: vec3<f32>, k: u32, s: f32, margin: f32) -> Manifold {
     var m = empty_manifold();
-    let p0 = c - d * l;
-    let e = d * (2.0 * l);
+    let l = local.half_length;
+    let r = local.radius;
+    let p0 = local.centre - local.dir * l;
+    let e = local.dir * (2.0 * l);
     var enter = 0.0;
     var leave = 1.0;
     for (var step = 1u; step < 3u; step = step + 1u) {

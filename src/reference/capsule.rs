@@ -110,6 +110,7 @@ pub fn box_capsule(cb: Vec3, rot: Quat, h: Vec3, capsule: &Swept, margin: f32) -
     let c = to_local * (capsule.centre - cb);
     let d = to_local * capsule.dir;
     let (l, r) = (capsule.half_length, capsule.radius);
+    let local = Swept { centre: c, dir: d, ..*capsule };
     // the box's face axes
     let face_sep = c.abs() - h - d.abs() * l;
     let face = if face_sep.x >= face_sep.y && face_sep.x >= face_sep.z {
@@ -161,7 +162,7 @@ pub fn box_capsule(cb: Vec3, rot: Quat, h: Vec3, capsule: &Swept, margin: f32) -
         } else {
             2
         };
-        let on_face = if n[k].abs() >= FACE_ALIGNED { face_points(c, d, l, r, h, k, sign(n[k]), margin) } else { Vec::new() };
+        let on_face = if n[k].abs() >= FACE_ALIGNED { face_points(&local, h, k, sign(n[k]), margin) } else { Vec::new() };
         if on_face.is_empty() {
             (n, vec![(on_box, on_seg - n * r)])
         } else {
@@ -186,7 +187,7 @@ pub fn box_capsule(cb: Vec3, rot: Quat, h: Vec3, capsule: &Swept, margin: f32) -
         let s = sign(c[face]);
         let mut n = Vec3::ZERO;
         n[face] = s;
-        (n, face_points(c, d, l, r, h, face, s, margin))
+        (n, face_points(&local, h, face, s, margin))
     };
     let points: Vec<ContactPoint> = points
         .into_iter()
@@ -238,10 +239,11 @@ fn nearest_to_box(c: Vec3, d: Vec3, l: f32, h: Vec3) -> f32 {
     0.5 * (lo + hi)
 }
 
-/// The capsule against face `k` (outward sign `s`) of the box, in the box's
-/// frame: its segment clipped to the face's sides, each end of what is left
+/// The capsule (`local`: in the box's frame) against face `k` (outward sign
+/// `s`) of the box: its segment clipped to the face's sides, each end of what is left
 /// a point (on the face, on the capsule) if within the margin.
-fn face_points(c: Vec3, d: Vec3, l: f32, r: f32, h: Vec3, k: usize, s: f32, margin: f32) -> Vec<(Vec3, Vec3)> {
+fn face_points(local: &Swept, h: Vec3, k: usize, s: f32, margin: f32) -> Vec<(Vec3, Vec3)> {
+    let (c, d, l, r) = (local.centre, local.dir, local.half_length, local.radius);
     let (p0, p1) = (c - d * l, c + d * l);
     let e = p1 - p0;
     let (mut enter, mut leave) = (0.0_f32, 1.0_f32);

@@ -98,7 +98,7 @@ fn random_with_capsule(rng: &mut Rng, k: usize, at: Vec3) -> Body {
         return random_body(rng, k, at);
     }
     let (radius, half_height) =
-        if k % 2 == 0 { (0.05 + 0.3 * rng.f(), 0.3 + rng.f()) } else { (0.1 + 0.4 * rng.f(), 0.02 + 0.2 * rng.f()) };
+        if k.is_multiple_of(2) { (0.05 + 0.3 * rng.f(), 0.3 + rng.f()) } else { (0.1 + 0.4 * rng.f(), 0.02 + 0.2 * rng.f()) };
     let mut b = Body::new(Shape::Capsule { radius, half_height }, at.to_array());
     b.orientation = rng.quat().to_array();
     b

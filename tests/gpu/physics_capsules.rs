@@ -121,9 +121,9 @@ fn a_heap_of_capsules_settles_without_passing_through() {
         rot: quat(state[i].orientation),
         shape: ShapeKind::from(&scene.bodies[i].shape),
     };
-    for i in 0..150 {
+    for (i, s) in state.iter().enumerate().take(150) {
         let Shape::Capsule { radius, half_height } = scene.bodies[i].shape else { unreachable!() };
-        lowest = lowest.min(state[i].position[1] - axis(&state[i]).y.abs() * half_height - radius);
+        lowest = lowest.min(s.position[1] - axis(s).y.abs() * half_height - radius);
         for j in i + 1..scene.bodies.len() {
             if let Some(m) = collide(&placed(i), &placed(j), 0.0) {
                 deepest = deepest.max(m.points.iter().map(|p| -p.separation(m.normal)).fold(0.0, f32::max));
