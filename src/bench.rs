@@ -16,7 +16,8 @@ pub const SEED: u64 = 1;
 /// The named cases: (name, built-in scene, count; `None`: the scene's
 /// default). `cubes-1m` runs at the adapter's maximum when 1M does not fit.
 /// `pile-*` are cubes dropped in four layers that land on each other and
-/// heap up three and four deep (`verlet scene pile`). `large_pyramid`,
+/// heap up three and four deep (`verlet scene pile`); `capsules-*` the same
+/// with capsules of random sizes (`verlet scene capsules`). `large_pyramid`,
 /// `many_pyramids` and `joint_grid` are Box3D's benchmarks of those names
 /// at Box3D's sizes.
 pub const CASES: &[(&str, &str, Option<usize>)] = &[
@@ -28,6 +29,8 @@ pub const CASES: &[(&str, &str, Option<usize>)] = &[
     ("pile-10k", "pile", Some(10_000)),
     ("pile-100k", "pile", Some(100_000)),
     ("pile-1m", "pile", Some(1_000_000)),
+    ("capsules-1k", "capsules", Some(1_000)),
+    ("capsules-10k", "capsules", Some(10_000)),
     ("pyramid", "pyramid", Some(20)),
     ("chain", "chain", Some(21)),
     ("large_pyramid", "large_pyramid", Some(100)),

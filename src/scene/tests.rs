@@ -115,6 +115,29 @@ fn sphere_mass_and_inertia() {
     assert!(body.inverse_inertia().iter().all(|&x| close(x, 1.0 / 16.0)));
 }
 
+/// A capsule's mass is its cylinder's and its two caps' (one ball); its
+/// moments are the cylinder's and the caps' about the centre, the caps'
+/// centroids 3r/8 beyond the cylinder's ends.
+#[test]
+fn capsule_mass_and_inertia() {
+    let text = r#"{"bodies": [{"shape": {"type": "capsule", "radius": 0.5, "half_height": 1},
+                   "position": [0, 0, 0]}]}"#;
+    let body = Scene::from_json_str(text).unwrap().bodies.remove(0);
+    let pi = std::f64::consts::PI;
+    let (mc, ms) = (1000.0 * pi * 0.25 * 2.0, 1000.0 * 4.0 / 3.0 * pi * 0.125);
+    assert!(close(body.mass, (mc + ms) as f32));
+    let across = mc * (0.25 / 4.0 + 1.0 / 3.0) + ms * (0.4 * 0.25 + 1.0 + 0.75 * 0.5);
+    let along = mc * 0.25 / 2.0 + ms * 0.4 * 0.25;
+    let inv = body.inverse_inertia();
+    assert!(close(inv[0], (1.0 / across) as f32) && close(inv[2], (1.0 / across) as f32), "{inv:?}");
+    assert!(close(inv[1], (1.0 / along) as f32), "{inv:?}");
+    assert_eq!(body.bounding_radius(), 1.5);
+    let scene = Scene { bodies: vec![body], ..Scene::default() };
+    let text = scene.to_json();
+    assert!(text.contains(r#""type": "capsule", "radius": 0.5, "half_height": 1.0 "#), "{text}");
+    assert_eq!(Scene::from_json_str(&text).unwrap(), scene);
+}
+
 #[test]
 fn body_new_uses_default_density() {
     let body = Body::new(Shape::Box { half_extents: [0.5; 3] }, [0.0, 1.0, 0.0]);

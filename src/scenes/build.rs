@@ -1,6 +1,8 @@
 //! The built-in scenes of our own, and the bodies they are made of; the
 //! Box3D benchmarks are in `box3d.rs`, the table naming them all in `mod.rs`.
 
+use glam::{Quat, Vec3};
+
 use crate::scene::{Body, Ground, Joint, Scene, Settings, Shape};
 
 /// A box body at rest with density 1000 kg/m^3.
@@ -205,6 +207,16 @@ pub fn bridge(count: usize) -> Scene {
 /// `ragdoll`: `count` ragdolls (head, torso, upper and lower arms and legs on
 /// ball joints) dropped in a row onto a pile of boxes.
 pub fn ragdoll(count: usize) -> Scene {
+    ragdolls(count, false)
+}
+
+/// `capsule_ragdoll`: the `ragdoll` scene with capsules for limbs (as long
+/// and as thick as the boxes they replace) and a ball for a head.
+pub fn capsule_ragdoll(count: usize) -> Scene {
+    ragdolls(count, true)
+}
+
+fn ragdolls(count: usize, capsules: bool) -> Scene {
     let mut bodies = Vec::new();
     let mut joints = Vec::new();
     // the pile: a 3 x 3 base of boxes with one box on top
@@ -214,11 +226,25 @@ pub fn ragdoll(count: usize) -> Scene {
         }
     }
     bodies.push(box_body([0.5; 3], [0.0, 1.5, 0.0]));
+    // a limb lying along x, as a capsule: its segment (the body's y) turned onto x
+    let onto_x = Quat::from_rotation_z(-std::f32::consts::FRAC_PI_2);
     for r in 0..count {
-        let base = bodies.len() as i32;
+        let base = bodies.len();
         let (x, y, z) = ((r % 3) as f32 * 0.8 - 0.8, 3.5 + (r / 3) as f32 * 2.5, (r % 2) as f32 * 0.5 - 0.25);
         let mut part = |half: [f32; 3], at: [f32; 3]| {
-            bodies.push(box_body(half, [x + at[0], y + at[1], z + at[2]]));
+            let mut b = box_body(half, [x + at[0], y + at[1], z + at[2]]);
+            // a limb: long along x or y, square across (the torso stays a box)
+            let long = if half[0] > half[1] { 0 } else { 1 };
+            if capsules && half[2] < half[long] && half[2] == half[1 - long] {
+                let radius = half[2];
+                b = Body::new(Shape::Capsule { radius, half_height: half[long] - radius }, b.position);
+                if long == 0 {
+                    b.orientation = onto_x.to_array();
+                }
+            } else if capsules && half == [half[0]; 3] {
+                b = Body::new(Shape::Sphere { radius: half[0] }, b.position);
+            }
+            bodies.push(b);
         };
         part([0.2, 0.3, 0.12], [0.0, 0.0, 0.0]); // 0 torso
         part([0.12, 0.12, 0.12], [0.0, 0.45, 0.0]); // 1 head
@@ -228,14 +254,20 @@ pub fn ragdoll(count: usize) -> Scene {
             part([0.07, 0.2, 0.07], [side * 0.1, -0.5, 0.0]); // upper leg
             part([0.07, 0.2, 0.07], [side * 0.1, -0.9, 0.0]); // lower leg
         }
-        let j = |a: i32, b: i32, pa: [f32; 3], pb: [f32; 3]| Joint { bodies: [base + a, base + b], anchors: [pa, pb] };
-        joints.push(j(0, 1, [0.0, 0.33, 0.0], [0.0, -0.12, 0.0])); // neck
+        // anchors as offsets along the world's axes, into each part's frame
+        let local = |part: usize, offset: [f32; 3]| {
+            (Quat::from_array(bodies[base + part].orientation).conjugate() * Vec3::from(offset)).to_array()
+        };
+        let mut j = |a: usize, b: usize, pa: [f32; 3], pb: [f32; 3]| {
+            joints.push(Joint { bodies: [(base + a) as i32, (base + b) as i32], anchors: [local(a, pa), local(b, pb)] });
+        };
+        j(0, 1, [0.0, 0.33, 0.0], [0.0, -0.12, 0.0]); // neck
         for (s, side) in [(0, -1.0f32), (1, 1.0)] {
             let ua = 2 + s * 4;
-            joints.push(j(0, ua, [side * 0.2, 0.25, 0.0], [-side * 0.15, 0.0, 0.0])); // shoulder
-            joints.push(j(ua, ua + 1, [side * 0.15, 0.0, 0.0], [-side * 0.15, 0.0, 0.0])); // elbow
-            joints.push(j(0, ua + 2, [side * 0.1, -0.3, 0.0], [0.0, 0.2, 0.0])); // hip
-            joints.push(j(ua + 2, ua + 3, [0.0, -0.2, 0.0], [0.0, 0.2, 0.0])); // knee
+            j(0, ua, [side * 0.2, 0.25, 0.0], [-side * 0.15, 0.0, 0.0]); // shoulder
+            j(ua, ua + 1, [side * 0.15, 0.0, 0.0], [-side * 0.15, 0.0, 0.0]); // elbow
+            j(0, ua + 2, [side * 0.1, -0.3, 0.0], [0.0, 0.2, 0.0]); // hip
+            j(ua + 2, ua + 3, [0.0, -0.2, 0.0], [0.0, 0.2, 0.0]); // knee
         }
     }
     // Damped like air (the paper's beta = 0.005 per step, as `chain`): on
@@ -246,6 +278,23 @@ pub fn ragdoll(count: usize) -> Scene {
     s.settings.linear_damping = 0.005;
     s.settings.angular_damping = 0.005;
     s
+}
+
+/// `capsules`: `count` capsules of random sizes (radius 0.15 to 0.35 m, as
+/// long again as 0.2 to 1.2 m) at random orientations, dropped in layers as
+/// `pile` drops its cubes: they heap up.
+pub fn capsules(count: usize, seed: u64) -> Scene {
+    let side = ((count.div_ceil(4)) as f32).sqrt().ceil().max(1.0) as usize;
+    let mut rng = SplitMix64(seed ^ 0xca95_0000);
+    let bodies = scattered_cubes(count, seed, side, 1.6, 1.8, 0.2)
+        .into_iter()
+        .map(|cube| {
+            let radius = 0.15 + 0.2 * rng.next_f32();
+            let half_height = 0.1 + 0.5 * rng.next_f32();
+            Body { orientation: cube.orientation, ..Body::new(Shape::Capsule { radius, half_height }, cube.position) }
+        })
+        .collect();
+    scene(bodies, vec![])
 }
 
 /// `blast`: a wall of `columns` x 6 boxes of 0.5 m (5 cm apart along the

@@ -12,7 +12,8 @@ mod build;
 use box3d::SMALL_PYRAMID_BOXES;
 pub use box3d::{joint_grid, large_pyramid, many_pyramids};
 pub use build::{
-    blast, blast_track, box_body, bridge, chain, cubes, drop, hanging, pile, pyramid, ragdoll, sphere, sphere_body, stack,
+    blast, blast_track, box_body, bridge, capsule_ragdoll, capsules, chain, cubes, drop, hanging, pile, pyramid, ragdoll, sphere,
+    sphere_body, stack,
 };
 
 use crate::scene::Scene;
@@ -138,6 +139,14 @@ pub const SCENES: &[BuiltIn] = &[
         |n| n.saturating_mul(10).saturating_add(10),
         "{count} ragdolls dropped onto a pile of boxes",
     ),
+    BuiltIn::counted(
+        "capsule_ragdoll",
+        capsule_ragdoll,
+        10,
+        |n| n.saturating_mul(10).saturating_add(10),
+        "{count} ragdolls with capsule limbs and ball heads dropped onto a pile of boxes",
+    ),
+    BuiltIn::seeded("capsules", capsules, 1000, |n| n, "{count} random capsules dropped in four layers: they heap up ({seed})"),
     BuiltIn::counted(
         "blast",
         blast,
@@ -345,7 +354,7 @@ mod tests {
     fn the_derived_lists_follow_the_table() {
         let names: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
         assert_eq!(NAMES.to_vec(), names);
-        assert_eq!(RANDOM, ["cubes", "pile"]);
+        assert_eq!(RANDOM, ["cubes", "pile", "capsules"]);
         let mut unique = names.clone();
         unique.sort();
         unique.dedup();
