@@ -285,6 +285,34 @@ fn spheres_and_fixed_bodies_render() {
     assert!(is_red(img.get_pixel(s[0] as u32, s[1] as u32)) || img.get_pixel(s[0] as u32, s[1] as u32)[0] > 200);
 }
 
+/// A capsule lying along x is drawn as one: its colour under its segment's
+/// ends and middle and within its caps, not just beyond them.
+#[test]
+fn a_capsule_renders_as_a_capsule() {
+    let (r, h) = (0.3f32, 1.0f32);
+    let mut scene = scenes::drop();
+    let mut capsule = verlet::Body::new(verlet::Shape::Capsule { radius: r, half_height: h }, [0.0, 1.0, 0.0]);
+    capsule.orientation = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2).to_array();
+    scene.bodies = vec![capsule];
+    scene.camera = Some(Camera { position: [0.0, 1.0, 12.0], target: [0.0, 1.0, 0.0], fov_y: 30f32.to_radians() });
+    let Some(world) = crate::common::world(&scene) else { return };
+    let mut renderer = Renderer::new(world.gpu(), &scene, WIDTH, HEIGHT).unwrap();
+    renderer.set_body_color(0, [1.0, 0.0, 0.0]).unwrap();
+    let img = renderer.render(&world).unwrap();
+    // red, or its lighter tone (the octants of a round body alternate)
+    let red_at = |x: f32, y: f32| {
+        let p = renderer.project([x, y, 0.0]).unwrap();
+        let px = img.get_pixel(p[0] as u32, p[1] as u32);
+        px[0] as i32 > px[2] as i32 + 40
+    };
+    for x in [-h, -0.5 * h, 0.0, 0.5 * h, h, h + 0.8 * r, -h - 0.8 * r] {
+        assert!(red_at(x, 1.0), "no capsule at x = {x}");
+    }
+    for (x, y) in [(h + 1.3 * r, 1.0), (-h - 1.3 * r, 1.0), (0.0, 1.0 + 1.3 * r), (h + 0.8 * r, 1.0 + 0.8 * r)] {
+        assert!(!red_at(x, y), "capsule drawn at ({x}, {y}), outside it");
+    }
+}
+
 #[test]
 fn the_render_shader_validates_with_naga() {
     let module = verlet::gpu::shaders::validate(&render::shader_source()).unwrap_or_else(|e| panic!("render.wgsl:\n{e}"));
