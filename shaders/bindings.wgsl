@@ -324,7 +324,7 @@ fn contact_end_moves(i: u32) -> bool {
 }
 
 fn moves_by_contacts(s: BodyState, p: BodyProps) -> bool {
-    return !is_fixed(p) && !asleep(s);
+    return !is_fixed(p) && !is_kinematic(p) && !asleep(s);
 }
 
 fn contact_end(i: u32) -> ContactEnd {
@@ -349,6 +349,6 @@ fn contact_end(i: u32) -> ContactEnd {
         half_height = h.y;
     }
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
-                      world_inv_inertia(r, p.inv_inertia.xyz), moves_by_contacts(s, p), is_fixed(p),
+                      world_inv_inertia(r, p.inv_inertia.xyz), moves_by_contacts(s, p), is_fixed(p) || is_kinematic(p),
                       p.restitution, p.friction, radius, half_height);
 }

@@ -348,6 +348,12 @@ fn is_fixed(p: BodyProps) -> bool {
     return (p.flags & FLAG_FIXED) != 0u;
 }
 
+// A kinematic body moves by its own velocities alone: no gravity, damping,
+// contact or joint moves it, and it pushes what it meets.
+fn is_kinematic(p: BodyProps) -> bool {
+    return (p.flags & FLAG_KINEMATIC) != 0u;
+}
+
 // One body of a contact manifold as the contact passes see it: its poses,
 // masses and material; the ground is an end at the origin with no mass.
 struct ContactEnd {
@@ -360,7 +366,7 @@ struct ContactEnd {
     turn_m: mat3x3<f32>,      // rot's matrix less prev_rot's: what the last turn moved a point by
     inv_i_world: mat3x3<f32>, // the inverse inertia in world axes (world_inv_inertia)
     moves: bool,            // awake and not fixed: the contacts may move it
-    fixed: bool,            // a fixed body (not the ground)
+    fixed: bool,            // a fixed or kinematic body (not the ground): stays as the ground does
     restitution: f32,
     friction: f32,
     radius: f32,            // a sphere's or capsule's radius (m); 0 for a box or the ground

@@ -121,7 +121,8 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
             // the velocity reads back as v (the host adds the half substep of gravity
             // disp / h lags by, for a body no contact pressed)
             let v = op.a.xyz;
-            s.disp = v * h - 0.5 * input.gravity * (h * h);
+            // a kinematic body has no gravity to lag behind
+            s.disp = v * h - 0.5 * select(input.gravity, vec3<f32>(0.0), is_kinematic(p)) * (h * h);
             s.pos_low = s.pos_low & ~HELD;
             s.prev_rot = prev_rot_for_spin(s.rot, op.b.xyz, h);
         }

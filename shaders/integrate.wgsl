@@ -148,7 +148,9 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     // held by a contact, or by its joints (a joint island sleeps as a whole:
     // joint_rest gives its bodies the island's least rest time)
     let jointed = joint_start[i] != joint_start[i + 1u];
-    let resting = ((s.pos_low & HELD) != 0u || jointed) && point_speed(s, p) < SLEEP_SPEED;
+    // a kinematic body keeps its velocities: no gravity or damping, no sleep
+    let free = !is_kinematic(p);
+    let resting = ((s.pos_low & HELD) != 0u || jointed) && point_speed(s, p) < SLEEP_SPEED && free;
     if (asleep(s)) {
         if (!wake) {
             rest = s.rest_time;
@@ -168,9 +170,9 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     // eq. 11: the last displacement, rescaled to this step's length
     let ratio = dt / params.dt_prev;
     // eq. 12: damping keeps (1 - beta) of it
-    let carry = s.disp * (ratio * (1.0 - params.linear_damping));
+    let carry = s.disp * (ratio * (1.0 - select(0.0, params.linear_damping, free)));
     // gravity: a dt (dt + dt_prev) / 2, exact for any pair of steps (eq. 6's a dt^2)
-    let accel = params.gravity * (dt * 0.5 * (dt + params.dt_prev));
+    let accel = select(vec3<f32>(0.0), params.gravity * (dt * 0.5 * (dt + params.dt_prev)), free);
     let disp = carry + accel;
     // pos + disp by Knuth's TwoSum: what the last addition's rounding dropped is
     // added back and what this one drops kept, so the position follows the
@@ -183,7 +185,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
 
     // eq. 7 with no torque: repeat the last turn, rescaled and damped towards none
     let last = quat_mul(s.rot, quat_conj(s.prev_rot));
-    let keep = ratio * (1.0 - params.angular_damping);
+    let keep = ratio * (1.0 - select(0.0, params.angular_damping, free));
     let turn = select(quat_from_rotvec(quat_to_rotvec(last) * keep), last, keep == 1.0);
     let rot = normalize(quat_mul(turn, s.rot));
     let spin = quat_to_rotvec(turn);

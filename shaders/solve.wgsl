@@ -201,7 +201,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var s = state_of(i);
     let p = props_of(i);
-    if (is_fixed(p) || asleep(s)) {
+    if (is_fixed(p) || is_kinematic(p) || asleep(s)) {
         set_state(i, s);
         return;
     }
@@ -405,9 +405,10 @@ fn island_joint(nth: u32) -> vec2<u32> {
     return vec2<u32>(lo, e);
 }
 
-// Whether the joints may move body i (not the world, not fixed).
+// Whether the joints may move body i (not the world, not fixed or kinematic).
 fn joint_moves(i: u32) -> bool {
-    return i != WORLD && !is_fixed(props_of(i));
+    let p = props_of(i);
+    return i != WORLD && !is_fixed(p) && !is_kinematic(p);
 }
 
 // Each joint adds its bodies' rest times and holds to its island's words.

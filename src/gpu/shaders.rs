@@ -33,6 +33,7 @@ pub fn shared_constants() -> String {
         ("SHAPE_SPHERE", SHAPE_SPHERE),
         ("SHAPE_CAPSULE", SHAPE_CAPSULE),
         ("FLAG_FIXED", FLAG_FIXED),
+        ("FLAG_KINEMATIC", FLAG_KINEMATIC),
         ("GRID_BODY", GRID_BODY),
         ("LARGE_BODY", LARGE_BODY),
         ("WORKGROUP", WORKGROUP),

@@ -304,6 +304,8 @@ pub const SHAPE_SPHERE: u32 = 1;
 pub const SHAPE_CAPSULE: u32 = 2;
 /// `BodyProps::flags` bit: the body never moves.
 pub const FLAG_FIXED: u32 = 1;
+/// A kinematic body: moved by its own velocities alone (`Body::kinematic`).
+pub const FLAG_KINEMATIC: u32 = 2;
 /// `BodyProps::grid_class` of a body in the broadphase grid, and of one too
 /// large for it (`GRID_BODY`, `LARGE_BODY` in WGSL).
 pub const GRID_BODY: u32 = 0;

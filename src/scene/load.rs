@@ -78,6 +78,7 @@ pub(super) struct RawBody {
     density: Option<f32>,
     mass: Option<f32>,
     fixed: Option<bool>,
+    kinematic: Option<bool>,
     restitution: Option<f32>,
     friction: Option<f32>,
 }
@@ -216,6 +217,7 @@ impl RawBody {
             angular_velocity: optional_vec3(self.angular_velocity, &format!("{path}.angular_velocity"))?,
             mass,
             fixed: self.fixed.unwrap_or(false),
+            kinematic: self.kinematic.unwrap_or(false),
             restitution: self.restitution,
             friction: self.friction,
         };

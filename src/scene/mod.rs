@@ -297,6 +297,11 @@ pub struct Body {
     /// An immovable body (infinite mass): its inverse mass and inverse
     /// inertia are zero.
     pub fixed: bool,
+    /// A body that moves by its own velocities alone (`linear_velocity`,
+    /// `angular_velocity`, or what inputs set), as if of infinite mass:
+    /// gravity, contacts and joints never move it, and it pushes what it
+    /// meets, friction included. Not also `fixed`.
+    pub kinematic: bool,
     /// Overrides [`Settings::restitution`] for contacts of this body.
     pub restitution: Option<f32>,
     /// Overrides [`Settings::friction`] for contacts of this body.
@@ -316,14 +321,21 @@ impl Body {
             angular_velocity: [0.0; 3],
             mass,
             fixed: false,
+            kinematic: false,
             restitution: None,
             friction: None,
         }
     }
 
-    /// 1 / mass in 1/kg; 0 for a fixed body.
+    /// Whether contacts, joints and gravity move the body: neither fixed
+    /// nor kinematic.
+    pub fn is_dynamic(&self) -> bool {
+        !self.fixed && !self.kinematic
+    }
+
+    /// 1 / mass in 1/kg; 0 for a fixed or kinematic body.
     pub fn inverse_mass(&self) -> f32 {
-        if self.fixed {
+        if !self.is_dynamic() {
             0.0
         } else {
             (1.0 / self.mass as f64) as f32
@@ -331,12 +343,13 @@ impl Body {
     }
 
     /// Inverse principal moments of inertia in 1/(kg·m²), in the body frame
-    /// (the diagonal of the inverse inertia tensor); zeros for a fixed body.
+    /// (the diagonal of the inverse inertia tensor); zeros for a fixed or
+    /// kinematic body.
     ///
     /// Solid box with half extents a, b, c: I = m/3 · (b² + c², a² + c²,
     /// a² + b²). Solid sphere: I = 2/5 · m · r² about every axis.
     pub fn inverse_inertia(&self) -> [f32; 3] {
-        if self.fixed {
+        if !self.is_dynamic() {
             return [0.0; 3];
         }
         let i = self.shape.inertia_f64(self.mass);

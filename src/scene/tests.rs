@@ -138,6 +138,24 @@ fn capsule_mass_and_inertia() {
     assert_eq!(Scene::from_json_str(&text).unwrap(), scene);
 }
 
+/// A kinematic body keeps its mass but has none to contacts (infinite),
+/// and is written back as kinematic; others are written without the field.
+#[test]
+fn kinematic_bodies_load_and_round_trip() {
+    let text = r#"{"bodies": [{"shape": {"type": "box", "half_extents": [1, 0.1, 1]}, "position": [0, 1, 0],
+                   "kinematic": true, "angular_velocity": [0, 1, 0]},
+                  {"shape": {"type": "sphere", "radius": 0.5}, "position": [0, 3, 0]}]}"#;
+    let scene = Scene::from_json_str(text).unwrap();
+    let table = &scene.bodies[0];
+    assert!(table.kinematic && !table.fixed && !table.is_dynamic());
+    assert_eq!(table.mass, 800.0);
+    assert_eq!((table.inverse_mass(), table.inverse_inertia()), (0.0, [0.0; 3]));
+    let written = scene.to_json();
+    assert_eq!(written.matches("\"kinematic\": true").count(), 1, "{written}");
+    assert!(!written.contains("\"kinematic\": false"));
+    assert_eq!(Scene::from_json_str(&written).unwrap(), scene);
+}
+
 #[test]
 fn body_new_uses_default_density() {
     let body = Body::new(Shape::Box { half_extents: [0.5; 3] }, [0.0, 1.0, 0.0]);

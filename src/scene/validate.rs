@@ -107,7 +107,7 @@ pub(crate) fn step_dt_problem(dt: f32, scene: &Scene) -> Option<String> {
 /// pushes in faster than `MAX_DEPENETRATION_SPEED` pushes out (figures in
 /// docs/limits.md). Only gravity's part along -y counts.
 pub(crate) fn check_sink(s: &Settings, bodies: &[Body]) -> Result<(), SceneError> {
-    let Some(smallest) = bodies.iter().filter(|b| !b.fixed).map(|b| b.bounding_radius()).reduce(f32::min) else {
+    let Some(smallest) = bodies.iter().filter(|b| b.is_dynamic()).map(|b| b.bounding_radius()).reduce(f32::min) else {
         return Ok(());
     };
     use crate::limits::MAX_DEPENETRATION_SPEED;
@@ -196,6 +196,12 @@ pub(crate) fn validate_body(body: &Body, path: &str, settings: &Settings) -> Res
     check_orientation(body.orientation, &format!("{path}.orientation"))?;
     check_all_finite(&body.linear_velocity, &format!("{path}.linear_velocity"))?;
     check_all_finite(&body.angular_velocity, &format!("{path}.angular_velocity"))?;
+    if body.fixed && body.kinematic {
+        return Err(SceneError::invalid(
+            format!("{path}.kinematic"),
+            "a body is fixed or kinematic, not both (a kinematic body at rest stays put as a fixed one does)",
+        ));
+    }
     // what the step would stop at once as a numerical fault (integrate.wgsl)
     if let Some(why) = position_problem(body.position) {
         return Err(SceneError::invalid(format!("{path}.position"), why));
@@ -236,7 +242,7 @@ pub(crate) fn mass_problem(shape: &Shape, mass: f32) -> Option<String> {
 /// but extreme mass and size can still overflow f32 in the inverse mass or
 /// inertia, and the solver needs those finite and positive.
 pub(super) fn inverse_problem(body: &Body) -> Option<String> {
-    if body.fixed {
+    if !body.is_dynamic() {
         return None;
     }
     let inverse_mass = body.inverse_mass();

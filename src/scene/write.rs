@@ -73,6 +73,9 @@ pub(super) fn body_json(body: &Body) -> String {
         ("mass", num(body.mass)),
         ("fixed", body.fixed.to_string()),
     ];
+    if body.kinematic {
+        fields.push(("kinematic", "true".to_string()));
+    }
     if let Some(restitution) = body.restitution {
         fields.push(("restitution", num(restitution)));
     }

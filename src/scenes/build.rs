@@ -16,6 +16,7 @@ pub fn box_body(half_extents: [f32; 3], position: [f32; 3]) -> Body {
         angular_velocity: [0.0; 3],
         mass: 1000.0 * 8.0 * h[0] * h[1] * h[2],
         fixed: false,
+        kinematic: false,
         restitution: None,
         friction: None,
     }

@@ -200,7 +200,7 @@ fn check_added(scene: &Scene, bodies: &[Body], joints: &[Joint]) -> Result<(), E
             };
             // the world's own bodies passed: the smallest new movable body is to blame
             let smallest = (0..bodies.len())
-                .filter(|&k| !bodies[k].fixed)
+                .filter(|&k| bodies[k].is_dynamic())
                 .min_by(|&a, &b| bodies[a].bounding_radius().total_cmp(&bodies[b].bounding_radius()))
                 .unwrap_or(0);
             return Err(Error::Input(format!("bodies[{smallest}].shape: too small for the world's settings: {why}")));

@@ -387,8 +387,9 @@ impl World {
     }
 
     /// Sets a body's velocities (m/s and rad/s, world frame): from here it
-    /// moves as a body loaded with them does, x + v t + g t^2 / 2, and
-    /// `read_state` before the next step shows v. No effect on a fixed body.
+    /// moves as a body loaded with them does, x + v t + g t^2 / 2 (a
+    /// kinematic one x + v t), and `read_state` before the next step shows
+    /// v. No effect on a fixed body.
     pub fn set_velocity(&mut self, body: usize, linear: [f32; 3], angular: [f32; 3]) -> Result<(), Error> {
         self.input_ops(&[BodyInput::Velocity { body, linear, angular }], "")
     }
@@ -546,6 +547,12 @@ impl World {
                 }
                 BodyInput::Fixed { fixed, mass, .. } => {
                     let scene = &self.scene.bodies[body];
+                    if scene.kinematic {
+                        return Err(Error::Input(format!(
+                            "{}: body {body} is kinematic: it moves by the velocities set on it (set it to none to hold it still)",
+                            at("body")
+                        )));
+                    }
                     if let Some(m) = mass {
                         // what the scene's own mass is checked by, for the body's shape
                         check_sane(&at("mass"), crate::scene::mass_problem(&scene.shape, m))?;

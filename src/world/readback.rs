@@ -83,16 +83,18 @@ impl World {
         if let Some(fault) = self.faults()? {
             return Err(Error::Diverged(fault.to_string()));
         }
-        let mut joined = vec![false; states.len()];
+        // bodies gravity may not be accelerating: those on joints, kinematic ones
+        let mut not_free: Vec<bool> = self.scene.bodies.iter().map(|b| b.kinematic).collect();
+        not_free.resize(states.len(), false);
         for j in &self.scene.joints {
             for b in j.bodies {
-                if let Some(k) = usize::try_from(b).ok().filter(|&k| k < joined.len()) {
-                    joined[k] = true;
+                if let Some(k) = usize::try_from(b).ok().filter(|&k| k < not_free.len()) {
+                    not_free[k] = true;
                 }
             }
         }
         let gravity = self.settings.gravity;
-        let out: Vec<BodyOutput> = states.iter().zip(&joined).map(|(s, &j)| body_output(s, dt, gravity, j)).collect();
+        let out: Vec<BodyOutput> = states.iter().zip(&not_free).map(|(s, &j)| body_output(s, dt, gravity, j)).collect();
         if let Some(k) = out.iter().position(|b| !finite_output(b)) {
             return Err(Error::Diverged(format!(
                 "body {k} has a non-finite state after step {} (time {:.4} s)",

@@ -72,10 +72,12 @@ fn dquat(v: [f32; 4]) -> DQuat {
 /// accelerates at `gravity`; one that something held over the last substep
 /// (a contact pushed it, it is fixed or asleep: `HELD`) or that hangs on a
 /// joint is not known to, and resting on the ground it accelerates at none,
-/// so it reads `disp / dt`, which is 0 at rest. Angular velocity has no
-/// acceleration to correct (no torques): the last substep's turn over dt.
-pub(crate) fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], joined: bool) -> BodyOutput {
-    let free = s.pos_low & HELD == 0 && !joined;
+/// so it reads `disp / dt`, which is 0 at rest; a kinematic body never
+/// accelerates. `not_free`: the body hangs on a joint or is kinematic.
+/// Angular velocity has no acceleration to correct (no torques): the last
+/// substep's turn over dt.
+pub(crate) fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], not_free: bool) -> BodyOutput {
+    let free = s.pos_low & HELD == 0 && !not_free;
     let half_step = if free { DVec3::from_array(gravity.map(|g| g as f64)) * (0.5 * dt) } else { DVec3::ZERO };
     let disp = DVec3::new(s.disp[0] as f64, s.disp[1] as f64, s.disp[2] as f64);
     let v = disp / dt + half_step;
@@ -161,7 +163,7 @@ impl JointLists {
 
 pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
     let n = scene.bodies.len();
-    let movable = |b: i32| b >= 0 && !scene.bodies[b as usize].fixed;
+    let movable = |b: i32| b >= 0 && scene.bodies[b as usize].is_dynamic();
     let mut per_body: Vec<Vec<JointRef>> = vec![Vec::new(); n];
     for j in &scene.joints {
         for me in 0..2 {
@@ -280,7 +282,7 @@ fn joint_end(j: &crate::scene::Joint, me: usize) -> JointRef {
 /// the paths in colour order, each with whether it is a whole island, and
 /// where each colour begins.
 fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usize>]) -> (Vec<(Vec<JointRef>, bool)>, Vec<u32>) {
-    let movable = |b: u32| b != WORLD && !scene.bodies[b as usize].fixed;
+    let movable = |b: u32| b != WORLD && scene.bodies[b as usize].is_dynamic();
     // joint k seen from its end at body `at`
     let end_at = |k: usize, at: u32| joint_end(&scene.joints[k], usize::from(scene.joints[k].bodies[0] != at as i32));
     let mut taken = vec![false; scene.joints.len()];
@@ -413,7 +415,8 @@ pub(crate) fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayou
 /// friction, damping, contacts and joints add none; twice the speed leaves
 /// the integration's own error room. With gravity but no ground under it
 /// (none, or gravity not straight down) a fall has no bound, and no body
-/// gets a limit; fixed bodies need none.
+/// gets a limit; fixed and kinematic bodies need none, and where a
+/// kinematic body moves (it can add energy without end) no body gets one.
 pub(crate) fn speed_limits(scene: &Scene) -> Vec<f32> {
     let g = DVec3::from_array(scene.settings.gravity.map(|v| v as f64));
     let ground = match &scene.ground {
@@ -421,9 +424,14 @@ pub(crate) fn speed_limits(scene: &Scene) -> Vec<f32> {
         _ if g == DVec3::ZERO => None,
         _ => return vec![0.0; scene.bodies.len()],
     };
+    // a kinematic body that moves can add energy without end (a drum turning)
+    let moving = |v: [f32; 3]| v != [0.0; 3];
+    if scene.bodies.iter().any(|b| b.kinematic && (moving(b.linear_velocity) || moving(b.angular_velocity))) {
+        return vec![0.0; scene.bodies.len()];
+    }
     let push = crate::limits::MAX_DEPENETRATION_SPEED as f64;
     let mut energy = 0.0;
-    for b in scene.bodies.iter().filter(|b| !b.fixed) {
+    for b in scene.bodies.iter().filter(|b| b.is_dynamic()) {
         let m = b.mass as f64;
         let v = DVec3::from_array(b.linear_velocity.map(|v| v as f64));
         let w = DVec3::from_array(b.angular_velocity.map(|v| v as f64));
@@ -431,7 +439,7 @@ pub(crate) fn speed_limits(scene: &Scene) -> Vec<f32> {
         let fall = ground.map_or(0.0, |h| -g.y * (b.position[1] as f64 - h).max(0.0));
         energy += 0.5 * m * (v.length_squared() + push * push) + 0.5 * inertia * w.length_squared() + m * fall;
     }
-    scene.bodies.iter().map(|b| if b.fixed { 0.0 } else { (2.0 * (2.0 * energy / b.mass as f64).sqrt()) as f32 }).collect()
+    scene.bodies.iter().map(|b| if b.is_dynamic() { (2.0 * (2.0 * energy / b.mass as f64).sqrt()) as f32 } else { 0.0 }).collect()
 }
 
 /// The GPU record of a body's shape, mass and material.
@@ -448,7 +456,13 @@ pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
         restitution: b.restitution.unwrap_or(settings.restitution),
         friction: b.friction.unwrap_or(settings.friction),
         shape,
-        flags: if b.fixed { FLAG_FIXED } else { 0 },
+        flags: if b.fixed {
+            FLAG_FIXED
+        } else if b.kinematic {
+            FLAG_KINEMATIC
+        } else {
+            0
+        },
         grid_class: GRID_BODY,
         ..Default::default()
     }
@@ -469,7 +483,8 @@ pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
         let h = (settings.dt / settings.substeps as f32) as f64;
         let v0 = DVec3::from_array(b.linear_velocity.map(|v| v as f64));
         let w0 = DVec3::from_array(b.angular_velocity.map(|v| v as f64));
-        let g = DVec3::from_array(settings.gravity.map(|v| v as f64));
+        // a kinematic body moves by its velocities alone
+        let g = if b.kinematic { DVec3::ZERO } else { DVec3::from_array(settings.gravity.map(|v| v as f64)) };
         (v0 * h - 0.5 * g * h * h, (DQuat::from_scaled_axis(-w0 * h) * q0).normalize())
     };
     let v3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
@@ -576,7 +591,7 @@ mod tests {
             let count = lists.colours.last().copied().unwrap_or(0) as usize;
             let paths: Vec<&[JointRef]> =
                 lists.starts[first..first + count + 1].windows(2).map(|w| &lists.refs[w[0] as usize..w[1] as usize]).collect();
-            let moving = |b: u32| b != WORLD && !scene.bodies[b as usize].fixed;
+            let moving = |b: u32| b != WORLD && scene.bodies[b as usize].is_dynamic();
             let solved = scene.joints.iter().filter(|j| j.bodies.iter().any(|&b| b >= 0 && moving(b as u32))).count();
             // whole islands sweep as the pass asks, cut paths within a budget
             let closes = &lists.starts[first + count + 1..];

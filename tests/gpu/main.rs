@@ -21,6 +21,7 @@ mod physics_capsules;
 mod physics_contacts;
 mod physics_core;
 mod physics_joints;
+mod physics_kinematic;
 mod render;
 mod scene_fuzz;
 mod scene_validation;

@@ -75,13 +75,19 @@ mod rapier {
                     Vector::new(b.position[0], b.position[1], b.position[2]),
                     Rotation::from_xyzw(o[0], o[1], o[2], o[3]).normalize(),
                 );
-                let body = if b.fixed { RigidBodyBuilder::fixed() } else { RigidBodyBuilder::dynamic() }
-                    .pose(pose)
-                    .linvel(Vector::new(b.linear_velocity[0], b.linear_velocity[1], b.linear_velocity[2]))
-                    .angvel(Vector::new(b.angular_velocity[0], b.angular_velocity[1], b.angular_velocity[2]))
-                    .linear_damping(damping(s.linear_damping))
-                    .angular_damping(damping(s.angular_damping))
-                    .can_sleep(sleeping);
+                let body = if b.fixed {
+                    RigidBodyBuilder::fixed()
+                } else if b.kinematic {
+                    RigidBodyBuilder::kinematic_velocity_based()
+                } else {
+                    RigidBodyBuilder::dynamic()
+                }
+                .pose(pose)
+                .linvel(Vector::new(b.linear_velocity[0], b.linear_velocity[1], b.linear_velocity[2]))
+                .angvel(Vector::new(b.angular_velocity[0], b.angular_velocity[1], b.angular_velocity[2]))
+                .linear_damping(damping(s.linear_damping))
+                .angular_damping(damping(s.angular_damping))
+                .can_sleep(sleeping);
                 let shape = match b.shape {
                     Shape::Box { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
                     Shape::Sphere { radius } => ColliderBuilder::ball(radius),
