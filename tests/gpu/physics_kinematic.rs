@@ -111,3 +111,31 @@ fn an_input_sets_a_kinematic_bodys_velocity() {
     assert!(e.contains("kinematic"), "{e}");
     assert!(w.set_dynamic(0, 5.0).is_err());
 }
+
+/// A ball hung on a ball joint from a kinematic body that moves at a steady
+/// 1 m/s, started moving with it, hangs still below it as seen from the
+/// body (Galilean invariance): the joint carries it along, and nothing it
+/// does moves the kinematic body.
+#[test]
+fn a_ball_hung_from_a_moving_kinematic_body_is_carried_along() {
+    let mut scene = scenes::stack(0);
+    let mut carrier = box_body([0.2; 3], [0.0, 5.0, 0.0]);
+    carrier.kinematic = true;
+    carrier.linear_velocity = [1.0, 0.0, 0.0];
+    let mut ball = verlet::Body::new(verlet::Shape::Sphere { radius: 0.2 }, [0.0, 3.6, 0.0]);
+    ball.linear_velocity = [1.0, 0.0, 0.0];
+    scene.bodies = vec![carrier, ball];
+    scene.joints = vec![verlet::Joint { bodies: [0, 1], anchors: [[0.0, -0.2, 0.0], [0.0, 1.2, 0.0]] }];
+    let Some(mut w) = world(&scene) else { return };
+    w.step(300).unwrap();
+    let s = w.read_state().unwrap();
+    let below = v3(s[1].position) - v3(s[0].position);
+    eprintln!("after 5 s the ball hangs at {below:?} from the carrier, moving {:?}", s[1].linear_velocity);
+    assert!(
+        (s[0].position[0] - 5.0).abs() < 1e-3 && (s[0].position[1] - 5.0).abs() < 1e-5,
+        "the carrier strayed: {:?}",
+        s[0].position
+    );
+    assert!((below - Vec3::new(0.0, -1.4, 0.0)).length() < 0.01, "the ball hangs at {below:?}");
+    assert!((v3(s[1].linear_velocity) - Vec3::X).length() < 0.01, "the ball moves at {:?}", s[1].linear_velocity);
+}
