@@ -395,6 +395,7 @@ pub struct Camera {
 /// tracks (`crate::load_error`).
 pub type SceneError = crate::load_error::LoadError;
 
+pub mod hull;
 mod load;
 #[cfg(test)]
 mod tests;
