@@ -336,7 +336,7 @@ pub(crate) fn closest_on_edges(pa: Vec3, da: Vec3, la: f32, pb: Vec3, db: Vec3, 
 /// above it) that keep the deepest one and span the most area. Run on every
 /// face contact, as on the GPU: four or fewer points in general position
 /// all stay, a point that adds no area (between two others on a line) goes.
-fn reduce(points: Vec<(Vec2, f32)>) -> Vec<(Vec2, f32)> {
+pub(crate) fn reduce(points: Vec<(Vec2, f32)>) -> Vec<(Vec2, f32)> {
     // 1: deepest (the first of equals, as every choice here)
     let mut chosen = [0usize; 4];
     for (i, p) in points.iter().enumerate() {

@@ -4,3 +4,4 @@
 
 pub mod capsule;
 pub mod collide;
+pub mod hull;

@@ -13,6 +13,7 @@ mod collide_reference;
 mod determinism;
 mod device_faults;
 mod faults;
+mod hull_reference;
 mod input_track;
 mod kernels;
 mod layouts;

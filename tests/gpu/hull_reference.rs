@@ -1,0 +1,161 @@
+//! The CPU hull reference on random pairs of random hulls and boxes at
+//! random poses: no contact where they are more than the margin apart, a
+//! contact wherever they overlap, no point deeper than the true overlap
+//! (beyond `EDGE_BIAS`), every point on or in its polytope, at most four.
+
+use crate::common::Rng;
+use glam::Vec3;
+use verlet::reference::collide::EDGE_BIAS;
+use verlet::reference::hull::{hull_hull, Polytope};
+use verlet::scene::hull::Hull;
+
+const MARGIN: f32 = 0.02;
+const TOL: f32 = 2e-3;
+
+/// Distance from p to segment s-e.
+fn to_segment(p: Vec3, s: Vec3, e: Vec3) -> f32 {
+    let d = e - s;
+    let t = ((p - s).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    (p - (s + d * t)).length()
+}
+
+/// Distance from p to the polytope (0 inside): to its nearest face's
+/// polygon (the plane where p's foot falls inside it, else the polygon's sides).
+fn to_polytope(p: Vec3, q: &Polytope) -> f32 {
+    if q.faces.iter().all(|(n, d, _)| n.dot(p) - d <= 0.0) {
+        return 0.0;
+    }
+    let mut best = f32::MAX;
+    for (n, d, corners) in &q.faces {
+        let h = n.dot(p) - d;
+        let foot = p - *n * h;
+        let inside = (0..corners.len()).all(|k| {
+            let (a, b) = (q.vertices[corners[k]], q.vertices[corners[(k + 1) % corners.len()]]);
+            (b - a).cross(foot - a).dot(*n) >= 0.0
+        });
+        if inside {
+            best = best.min(h.abs());
+        }
+        for k in 0..corners.len() {
+            best = best.min(to_segment(p, q.vertices[corners[k]], q.vertices[corners[(k + 1) % corners.len()]]));
+        }
+    }
+    best
+}
+
+/// The true gap (positive) or overlap (negative): apart, the least distance
+/// over corner-face and edge-edge pairs; overlapping, minus the least push
+/// over every face normal and every pair of edge directions.
+fn true_gap(a: &Polytope, b: &Polytope) -> f32 {
+    let overlap_along = |l: Vec3| {
+        let span =
+            |q: &Polytope| q.vertices.iter().map(|v| v.dot(l)).fold((f32::MAX, f32::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        let ((a0, a1), (b0, b1)) = (span(a), span(b));
+        (a1 - b0).min(b1 - a0)
+    };
+    let mut axes: Vec<Vec3> = a.faces.iter().chain(&b.faces).map(|f| f.0).collect();
+    for &(i, j, _, _) in &a.edges {
+        for &(k, l, _, _) in &b.edges {
+            let c = (a.vertices[j] - a.vertices[i]).cross(b.vertices[l] - b.vertices[k]);
+            if c.length() > 1e-6 {
+                axes.push(c.normalize());
+            }
+        }
+    }
+    let push = axes.iter().map(|&l| overlap_along(l)).fold(f32::MAX, f32::min);
+    if push > 0.0 {
+        return -push;
+    }
+    let mut best = f32::MAX;
+    for v in &a.vertices {
+        best = best.min(to_polytope(*v, b));
+    }
+    for v in &b.vertices {
+        best = best.min(to_polytope(*v, a));
+    }
+    for &(i, j, _, _) in &a.edges {
+        for &(k, l, _, _) in &b.edges {
+            for t in 0..=20 {
+                let p = a.vertices[i].lerp(a.vertices[j], t as f32 / 20.0);
+                best = best.min(to_segment(p, b.vertices[k], b.vertices[l]));
+            }
+        }
+    }
+    best
+}
+
+fn random_polytope(rng: &mut Rng, k: usize) -> Polytope {
+    if k % 3 == 0 {
+        let h = Vec3::new(rng.range(0.1, 0.7), rng.range(0.05, 0.7), rng.range(0.1, 0.7));
+        return Polytope::from_box(h, Vec3::ZERO, rng.quat());
+    }
+    let scale = Vec3::new(rng.range(0.3, 1.0), rng.range(0.3, 1.0), rng.range(0.3, 1.0));
+    let n = 4 + (rng.f() * 28.0) as usize;
+    let points: Vec<[f32; 3]> =
+        (0..n).map(|_| (Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5) * scale).to_array()).collect();
+    Polytope::from_hull(&Hull::new(&points).unwrap(), Vec3::ZERO, rng.quat())
+}
+
+fn moved(p: &Polytope, by: Vec3) -> Polytope {
+    let mut q = p.clone();
+    q.vertices.iter_mut().for_each(|v| *v += by);
+    q.faces.iter_mut().for_each(|f| f.1 += f.0.dot(by));
+    q.centre += by;
+    q
+}
+
+#[test]
+fn hulls_keep_to_the_true_gap() {
+    let mut rng = Rng(0x4011_5eed_0000_0001);
+    let (mut touching, mut faults) = (0, Vec::new());
+    for k in 0..3000 {
+        let a = random_polytope(&mut rng, k);
+        let b = random_polytope(&mut rng, k + 1);
+        let reach = |p: &Polytope| p.vertices.iter().map(|v| (*v - p.centre).length()).fold(0.0, f32::max);
+        let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y);
+        let b = moved(&b, a.centre - b.centre + dir * (reach(&a) + reach(&b)) * rng.range(0.0, 0.9));
+        let gap = true_gap(&a, &b);
+        let m = hull_hull(&a, &b, MARGIN);
+        let Some(m) = m else {
+            if gap < -TOL {
+                faults.push(format!("pair {k}: overlap {gap} but no contact"));
+            }
+            continue;
+        };
+        touching += 1;
+        if gap > MARGIN + TOL {
+            faults.push(format!("pair {k}: {gap} apart but {} points", m.points.len()));
+        }
+        if m.points.is_empty() || m.points.len() > 4 || (m.normal.length() - 1.0).abs() > 1e-4 {
+            faults.push(format!("pair {k}: {} points, normal {:?}", m.points.len(), m.normal));
+        }
+        for p in &m.points {
+            let sep = p.separation(m.normal);
+            if sep < gap.min(0.0) - EDGE_BIAS - TOL {
+                faults.push(format!("pair {k}: a point {sep} deep where the overlap is {gap}"));
+            }
+            let (off_a, off_b) = (to_polytope(p.on_a, &a), to_polytope(p.on_b, &b));
+            if off_a > TOL || off_b > TOL {
+                faults.push(format!("pair {k}: a point off its polytope by {off_a} / {off_b}"));
+            }
+        }
+    }
+    assert!(faults.is_empty(), "{} faults: {:?}", faults.len(), &faults[..faults.len().min(10)]);
+    assert!(touching > 1500, "too few touching pairs: {touching}");
+}
+
+#[test]
+fn a_box_resting_on_a_hull_face_touches_at_its_four_corners() {
+    // a flat slab of eight points as a hull, a unit box resting on it 1 cm in
+    let slab: Vec<[f32; 3]> = (0..8)
+        .map(|k| [if k & 1 == 0 { -2.0 } else { 2.0 }, if k & 2 == 0 { -0.2 } else { 0.0 }, if k & 4 == 0 { -2.0 } else { 2.0 }])
+        .collect();
+    let floor = Polytope::from_hull(&Hull::new(&slab).unwrap(), Vec3::ZERO, glam::Quat::IDENTITY);
+    let cube = Polytope::from_box(Vec3::splat(0.5), Vec3::new(0.3, 0.49, -0.2), glam::Quat::IDENTITY);
+    let m = hull_hull(&floor, &cube, MARGIN).unwrap();
+    assert!((m.normal - Vec3::Y).length() < 1e-5, "{m:?}");
+    assert_eq!(m.points.len(), 4, "{m:?}");
+    for p in &m.points {
+        assert!((p.separation(m.normal) + 0.01).abs() < 1e-5 && p.on_a.y.abs() < 1e-5, "{p:?}");
+    }
+}
