@@ -7,7 +7,7 @@
 //! keeps up to four points, as two boxes do; an edge contact is the closest
 //! points of the two edges.
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{DVec3, Quat, Vec2, Vec3};
 
 use super::collide::{closest_on_edges, reduce, ContactPoint, Manifold, EDGE_BIAS, FACE_BIAS};
 use crate::scene::hull::Hull;
@@ -134,17 +134,27 @@ pub fn hull_hull(a: &Polytope, b: &Polytope, margin: f32) -> Option<Manifold> {
     let (sep_a, face_a) = best_face(a, b);
     let (sep_b, face_b) = best_face(b, a);
     let (sep_e, normal_e, edge_a, edge_b) = best_edges(a, b);
-    if sep_a.max(sep_b).max(sep_e) > margin {
+    let sep = sep_a.max(sep_b).max(sep_e);
+    // the axes' separation is the true distance's lower bound (two corners
+    // nearest each other are farther apart): where they say apart, the
+    // distance itself decides
+    if sep > margin || (sep > 0.0 && distance(&a.vertices, &b.vertices) > margin) {
         return None;
     }
     let best_face_sep = sep_a.max(sep_b);
     // b's face must beat a's by FACE_BIAS to be the reference (as for boxes)
     let flipped = sep_b > sep_a + FACE_BIAS;
     let (reference, incident, face) = if flipped { (b, a, face_b) } else { (a, b, face_a) };
-    let points = if sep_e > best_face_sep + EDGE_BIAS { Vec::new() } else { face_contact(reference, face, incident, margin) };
+    let edge = sep_e > best_face_sep + EDGE_BIAS;
+    let mut points = if edge { Vec::new() } else { face_contact(reference, face, incident, margin) };
+    if points.is_empty() && !edge {
+        // the other's face lies past the reference face's sides: its corner
+        // deepest along the face's normal, against the face's nearest point
+        let (n, d, _) = &reference.faces[face];
+        let deepest = incident.vertices.iter().copied().min_by(|p, q| n.dot(*p).total_cmp(&n.dot(*q))).expect("corners");
+        points = vec![(nearest_on_face(reference, face, deepest - *n * (n.dot(deepest) - d)), deepest)];
+    }
     if points.is_empty() {
-        // an edge contact, or a face contact whose clipping kept nothing (the
-        // other's face lies past the reference face's sides): the edges meet
         if sep_e == f32::MIN {
             return None;
         }
@@ -172,6 +182,27 @@ pub fn hull_hull(a: &Polytope, b: &Polytope, margin: f32) -> Option<Manifold> {
         )
         .collect();
     Some(Manifold { normal: if flipped { -n } else { n }, points })
+}
+
+/// The point of face `face` of `p` nearest `x`, a point in its plane: `x`
+/// where it lies within the face, else the nearest point of its sides.
+fn nearest_on_face(p: &Polytope, face: usize, x: Vec3) -> Vec3 {
+    let (n, _, corners) = &p.faces[face];
+    let side = |k: usize| (p.vertices[corners[k]], p.vertices[corners[(k + 1) % corners.len()]]);
+    if (0..corners.len()).all(|k| {
+        let (a, b) = side(k);
+        (b - a).cross(x - a).dot(*n) >= 0.0
+    }) {
+        return x;
+    }
+    (0..corners.len())
+        .map(|k| {
+            let (a, b) = side(k);
+            let t = ((x - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            a + (b - a) * t
+        })
+        .min_by(|p, q| (*p - x).length_squared().total_cmp(&(*q - x).length_squared()))
+        .expect("a face has sides")
 }
 
 /// The points of a face contact: `incident`'s face most anti-parallel to
@@ -220,4 +251,86 @@ fn face_contact(reference: &Polytope, face: usize, incident: &Polytope, margin: 
             (on_ref, on_ref + *n * height)
         })
         .collect()
+}
+
+/// The least distance between the convex hulls of two sets of points (0
+/// where they overlap), by GJK: the point of the Minkowski difference
+/// nearest the origin, approached by simplices of its support points.
+pub fn distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    let support = |d: DVec3| {
+        let far =
+            |set: &[Vec3], d: DVec3| set.iter().map(|p| p.as_dvec3()).max_by(|p, q| p.dot(d).total_cmp(&q.dot(d))).expect("points");
+        far(a, d) - far(b, -d)
+    };
+    let mut simplex = vec![support(DVec3::X)];
+    let mut v = simplex[0];
+    for _ in 0..64 {
+        let vv = v.length_squared();
+        if vv < 1e-18 {
+            return 0.0;
+        }
+        let w = support(-v);
+        // no support point nearer the origin along -v: v is the nearest
+        if vv - v.dot(w) <= 1e-9 * vv || simplex.iter().any(|p| (*p - w).length_squared() < 1e-24) {
+            break;
+        }
+        simplex.push(w);
+        (v, simplex) = nearest_on_simplex(&simplex);
+    }
+    v.length() as f32
+}
+
+/// The point of a simplex (1 to 4 points) nearest the origin, and the
+/// smallest face of it that holds that point: over every face, the nearest
+/// point of its affine hull, kept where it lies within the face.
+fn nearest_on_simplex(points: &[DVec3]) -> (DVec3, Vec<DVec3>) {
+    let mut best: Option<(f64, DVec3, Vec<DVec3>)> = None;
+    for mask in 1u32..(1 << points.len()) {
+        let face: Vec<DVec3> = (0..points.len()).filter(|k| mask & (1 << k) != 0).map(|k| points[k]).collect();
+        let Some(x) = nearest_in_face(&face) else { continue };
+        let d = x.length_squared();
+        // fewer points for equal distances: the smallest face that holds it
+        if best.as_ref().is_none_or(|(bd, _, bf)| d < bd - 1e-18 || (d <= bd + 1e-18 && face.len() < bf.len())) {
+            best = Some((d, x, face));
+        }
+    }
+    let (_, x, face) = best.expect("a single point is always its own face");
+    (x, face)
+}
+
+/// The nearest point to the origin of the affine hull of `face`, where it
+/// lies within `face` (its weights all at least 0); None otherwise.
+fn nearest_in_face(face: &[DVec3]) -> Option<DVec3> {
+    let p0 = face[0];
+    let e: Vec<DVec3> = face[1..].iter().map(|p| *p - p0).collect();
+    let k = e.len();
+    // the normal equations G mu = -E^T p0, k <= 3, by Gaussian elimination
+    let mut m = [[0.0f64; 4]; 3];
+    for i in 0..k {
+        for j in 0..k {
+            m[i][j] = e[i].dot(e[j]);
+        }
+        m[i][3] = -e[i].dot(p0);
+    }
+    for c in 0..k {
+        let pivot = (c..k).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs()))?;
+        if m[pivot][c].abs() < 1e-18 {
+            return None;
+        }
+        m.swap(c, pivot);
+        for r in 0..k {
+            if r != c {
+                let f = m[r][c] / m[c][c];
+                for col in c..4 {
+                    m[r][col] -= f * m[c][col];
+                }
+            }
+        }
+    }
+    let mu: Vec<f64> = (0..k).map(|i| m[i][3] / m[i][i]).collect();
+    let first = 1.0 - mu.iter().sum::<f64>();
+    if first < -1e-9 || mu.iter().any(|&w| w < -1e-9) {
+        return None;
+    }
+    Some(p0 + e.iter().zip(&mu).map(|(d, w)| *d * *w).sum::<DVec3>())
 }

@@ -75,13 +75,27 @@ fn true_gap(a: &Polytope, b: &Polytope) -> f32 {
     }
     for &(i, j, _, _) in &a.edges {
         for &(k, l, _, _) in &b.edges {
-            for t in 0..=20 {
-                let p = a.vertices[i].lerp(a.vertices[j], t as f32 / 20.0);
-                best = best.min(to_segment(p, b.vertices[k], b.vertices[l]));
-            }
+            best = best.min(segments_apart(a.vertices[i], a.vertices[j], b.vertices[k], b.vertices[l]));
         }
     }
     best
+}
+
+/// The least distance between segments p0-p1 and q0-q1: the least of a
+/// fine search along the first (the distance to the second is convex along
+/// it), refined by golden sections.
+fn segments_apart(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> f32 {
+    let at = |t: f32| to_segment(p0.lerp(p1, t), q0, q1);
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for _ in 0..60 {
+        let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+        if at(m1) <= at(m2) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    at(0.5 * (lo + hi)).min(at(0.0)).min(at(1.0))
 }
 
 fn random_polytope(rng: &mut Rng, k: usize) -> Polytope {
