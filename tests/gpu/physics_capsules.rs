@@ -136,3 +136,22 @@ fn a_heap_of_capsules_settles_without_passing_through() {
         |s: &[BodyOutput]| s.iter().flat_map(|b| b.position.into_iter().chain(b.orientation)).map(f32::to_bits).collect::<Vec<_>>();
     assert!(bits(&state) == bits(&again), "a second run differs");
 }
+
+/// Ten ragdolls with capsule limbs and ball heads (`capsule_ragdoll`),
+/// dropped on a pile of boxes, keep their joints closed and come to rest:
+/// limbs that roll about their axes settle later than boxes do.
+#[test]
+fn ten_capsule_ragdolls_come_to_rest_on_a_pile() {
+    let scene = scenes::capsule_ragdoll(10);
+    let Some(mut w) = world(&scene) else { return };
+    let mut worst = 0.0f32;
+    for _ in 0..1800 {
+        w.step(1).unwrap();
+        worst = worst.max(verlet::world::joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max));
+    }
+    let state = w.read_state().unwrap();
+    let fastest = state.iter().map(|b| v3(b.linear_velocity).length()).fold(0.0, f32::max);
+    eprintln!("capsule ragdolls: worst joint gap {worst} m, fastest body after 30 s {fastest} m/s");
+    assert!(worst < 0.02, "a ragdoll joint opened {worst} m");
+    assert!(fastest < 0.1, "ragdolls still moving at {fastest} m/s");
+}
