@@ -1,7 +1,8 @@
 // Contact manifolds between boxes and spheres: the twin of
 // src/reference/collide.rs, step for step (its box_box is box_box_axis, then
-// box_box_edge or box_box_face here); capsules' in capsule.wgsl. A manifold's normal points from the
-// first shape to the second; dot(on_b - on_a, n) < 0 where the shapes overlap.
+// box_box_edge or box_box_face here); capsules' are in capsule.wgsl. A
+// manifold's normal points from the first shape to the second;
+// dot(on_b - on_a, n) < 0 where the shapes overlap.
 
 
 // An edge axis must beat the best face axis by this much (m) to be chosen.

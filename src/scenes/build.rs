@@ -281,8 +281,8 @@ fn ragdolls(count: usize, capsules: bool) -> Scene {
     s
 }
 
-/// `capsules`: `count` capsules of random sizes (radius 0.15 to 0.35 m, as
-/// long again as 0.2 to 1.2 m) at random orientations, dropped in layers as
+/// `capsules`: `count` capsules of random sizes (radius 0.15 to 0.35 m,
+/// segment 0.2 to 1.2 m long) at random orientations, dropped in layers as
 /// `pile` drops its cubes: they heap up.
 pub fn capsules(count: usize, seed: u64) -> Scene {
     let side = ((count.div_ceil(4)) as f32).sqrt().ceil().max(1.0) as usize;

@@ -2,7 +2,7 @@
 //! gives, resting on a side and on an end, on the ground and on a box, and a
 //! pile that settles without passing through the ground or each other.
 
-use crate::common::{quat, v3, world};
+use crate::common::{quat, ramp, v3, world};
 use glam::{Quat, Vec3};
 use verlet::reference::collide::{collide, Placed, ShapeKind};
 use verlet::scenes::{self, box_body};
@@ -27,14 +27,10 @@ fn axis(s: &BodyOutput) -> Vec3 {
 fn a_capsule_rolls_down_a_ramp_at_the_rate_rolling_gives() {
     let (r, h) = (0.2f32, 0.5f32);
     let angle = 20f32.to_radians();
-    let tilt = Quat::from_rotation_z(angle);
     let mut scene = scenes::stack(0);
-    let mut ramp = box_body([5.0, 0.1, 2.0], [0.0, 3.0, 0.0]);
-    ramp.orientation = tilt.to_array();
-    ramp.fixed = true;
-    // the ramp rises towards +x; the capsule's axis lies along z, across it
+    // the capsule's axis lies along z, across the ramp
+    let (ramp, tilt, start) = ramp(r);
     let (along, normal) = (tilt * Vec3::X, tilt * Vec3::Y);
-    let start = Vec3::new(0.0, 3.0, 0.0) + along * 3.5 + normal * (0.1 + r);
     let body = capsule(r, h, start, tilt * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2));
     // the moment about the axis per m r^2, as Shape::inertia_f64 sums it
     let (cylinder, ball) = (2.0 * h, 4.0 / 3.0 * r);
@@ -139,4 +135,23 @@ fn a_heap_of_capsules_settles_without_passing_through() {
     let bits =
         |s: &[BodyOutput]| s.iter().flat_map(|b| b.position.into_iter().chain(b.orientation)).map(f32::to_bits).collect::<Vec<_>>();
     assert!(bits(&state) == bits(&again), "a second run differs");
+}
+
+/// Ten ragdolls with capsule limbs and ball heads (`capsule_ragdoll`),
+/// dropped on a pile of boxes, keep their joints closed and come to rest:
+/// limbs that roll about their axes settle later than boxes do.
+#[test]
+fn ten_capsule_ragdolls_come_to_rest_on_a_pile() {
+    let scene = scenes::capsule_ragdoll(10);
+    let Some(mut w) = world(&scene) else { return };
+    let mut worst = 0.0f32;
+    for _ in 0..1800 {
+        w.step(1).unwrap();
+        worst = worst.max(verlet::world::joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max));
+    }
+    let state = w.read_state().unwrap();
+    let fastest = state.iter().map(|b| v3(b.linear_velocity).length()).fold(0.0, f32::max);
+    eprintln!("capsule ragdolls: worst joint gap {worst} m, fastest body after 30 s {fastest} m/s");
+    assert!(worst < 0.02, "a ragdoll joint opened {worst} m");
+    assert!(fastest < 0.1, "ragdolls still moving at {fastest} m/s");
 }

@@ -395,17 +395,10 @@ fn a_spinning_box_meets_a_wall_without_a_corner_sinking_in() {
 }
 
 fn ramp_slide(mu: f32) -> f32 {
-    let angle = 20f32.to_radians();
-    let tilt = Quat::from_rotation_z(angle);
     let mut scene = scenes::stack(0);
-    let mut ramp = box_body([5.0, 0.1, 2.0], [0.0, 3.0, 0.0]);
-    ramp.orientation = tilt.to_array();
-    ramp.fixed = true;
+    // the block starts near the ramp's upper end, resting on it
+    let (mut ramp, tilt, start) = crate::common::ramp(0.25);
     ramp.friction = Some(mu);
-    // the ramp rises towards +x: the block starts near its upper end, resting on it
-    let along = tilt * Vec3::X;
-    let normal = tilt * Vec3::Y;
-    let start = Vec3::new(0.0, 3.0, 0.0) + along * 3.5 + normal * (0.1 + 0.25);
     let mut block = box_body([0.25; 3], start.to_array());
     block.orientation = tilt.to_array();
     block.friction = Some(mu);

@@ -99,3 +99,16 @@ impl Rng {
         glam::Quat::from_xyzw(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5, self.f() - 0.5).normalize()
     }
 }
+
+/// A fixed ramp (a 10 x 0.2 x 4 m slab) tilted 20 degrees about z, rising
+/// towards +x, its centre at (0, 3, 0); with its tilt, and the point `lift`
+/// above its top face 3.5 m up the slope from the centre (where a body
+/// starts resting on it).
+pub fn ramp(lift: f32) -> (verlet::Body, glam::Quat, glam::Vec3) {
+    let tilt = glam::Quat::from_rotation_z(20f32.to_radians());
+    let mut ramp = verlet::scenes::box_body([5.0, 0.1, 2.0], [0.0, 3.0, 0.0]);
+    ramp.orientation = tilt.to_array();
+    ramp.fixed = true;
+    let start = glam::Vec3::new(0.0, 3.0, 0.0) + tilt * glam::Vec3::X * 3.5 + tilt * glam::Vec3::Y * (0.1 + lift);
+    (ramp, tilt, start)
+}
