@@ -38,6 +38,8 @@ impl From<&Shape> for ShapeKind {
             Shape::Box { half_extents } => ShapeKind::Box(Vec3::from(half_extents)),
             Shape::Sphere { radius } => ShapeKind::Sphere(radius),
             Shape::Capsule { radius, half_height } => ShapeKind::Capsule { radius, half_height },
+            // hulls have their own reference (`hull.rs`); not placed as a ShapeKind yet
+            Shape::Hull(ref h) => ShapeKind::Sphere(h.hull().radius_about(h.hull().centroid) as f32),
         }
     }
 }

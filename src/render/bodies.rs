@@ -34,6 +34,8 @@ impl Instances {
                     Shape::Box { half_extents } => (half_extents, SHAPE_BOX),
                     Shape::Sphere { radius } => ([radius; 3], SHAPE_SPHERE),
                     Shape::Capsule { radius, half_height } => ([radius, half_height, radius], SHAPE_CAPSULE),
+                    // not drawn faceted yet (worlds refuse hulls until their contacts are on the GPU)
+                    Shape::Hull(ref h) => ([h.hull().radius_about(h.hull().centroid) as f32; 3], SHAPE_SPHERE),
                 };
                 if (shape != SHAPE_BOX) == round {
                     let srgb = if b.fixed { FIXED_SRGB } else { body_color(i) };

@@ -91,6 +91,7 @@ pub(super) struct RawShape {
     half_extents: Option<Vec<f32>>,
     radius: Option<f32>,
     half_height: Option<f32>,
+    points: Option<Vec<Vec<f32>>>,
 }
 
 #[derive(Deserialize)]
@@ -258,6 +259,23 @@ impl RawShape {
                 let radius = self.radius.ok_or_else(|| SceneError::missing(format!("{path}.radius")))?;
                 Ok(Shape::Sphere { radius })
             }
+            "hull" => {
+                for (field, given) in [("half_extents", self.half_extents.is_some()), ("radius", self.radius.is_some())] {
+                    if given {
+                        return Err(SceneError::invalid(format!("{path}.{field}"), "is not used by a hull; a hull takes points"));
+                    }
+                }
+                refuse_half_height(self.half_height, path, "a hull takes points")?;
+                let points_path = format!("{path}.points");
+                let raw = self.points.ok_or_else(|| SceneError::missing(&points_path))?;
+                let points = raw.into_iter().enumerate().map(|(k, p)| exact(p, &format!("{points_path}[{k}]"))).collect::<Result<
+                    Vec<[f32; 3]>,
+                    _,
+                >>(
+                )?;
+                let shape = super::HullShape::new(points).map_err(|why| SceneError::invalid(points_path, why))?;
+                Ok(Shape::Hull(shape))
+            }
             "capsule" => {
                 if self.half_extents.is_some() {
                     return Err(SceneError::invalid(
@@ -271,7 +289,7 @@ impl RawShape {
             }
             other => Err(SceneError::invalid(
                 type_path,
-                format!("unknown shape type {other:?}, expected \"box\", \"sphere\" or \"capsule\""),
+                format!("unknown shape type {other:?}, expected \"box\", \"sphere\", \"capsule\" or \"hull\""),
             )),
         }
     }

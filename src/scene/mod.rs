@@ -213,6 +213,35 @@ pub enum Shape {
     /// The segment from (0, -half_height, 0) to (0, half_height, 0) swept by
     /// `radius` (metres, both > 0): a cylinder capped by two half spheres.
     Capsule { radius: f32, half_height: f32 },
+    /// The convex hull of 4 to 64 points in the body's frame (see
+    /// [`HullShape`]).
+    Hull(HullShape),
+}
+
+/// A hull shape: the points as given, and the hull they make with its mass
+/// properties (worked out once, as the shape is made).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HullShape {
+    points: Vec<[f32; 3]>,
+    hull: std::sync::Arc<hull::Hull>,
+}
+
+impl HullShape {
+    /// The hull of `points`, or why they make none (see [`hull::Hull::new`]).
+    pub fn new(points: Vec<[f32; 3]>) -> Result<HullShape, String> {
+        let hull = std::sync::Arc::new(hull::Hull::new(&points)?);
+        Ok(HullShape { points, hull })
+    }
+
+    /// The points as given.
+    pub fn points(&self) -> &[[f32; 3]] {
+        &self.points
+    }
+
+    /// The hull: its corners, faces and mass properties, in the body's frame.
+    pub fn hull(&self) -> &hull::Hull {
+        &self.hull
+    }
 }
 
 impl Shape {
@@ -232,6 +261,7 @@ impl Shape {
                 let (r, h) = (radius as f64, half_height as f64);
                 std::f64::consts::PI * r * r * (2.0 * h + 4.0 / 3.0 * r)
             }
+            Shape::Hull(ref shape) => shape.hull.volume,
         }
     }
 
@@ -245,6 +275,8 @@ impl Shape {
             }
             Shape::Sphere { radius } => radius,
             Shape::Capsule { radius, half_height } => radius + half_height,
+            // about the centre of mass, where the body's pose is kept
+            Shape::Hull(ref shape) => shape.hull.radius_about(shape.hull.centroid) as f32,
         }
     }
 
@@ -272,6 +304,8 @@ impl Shape {
                 let along = mc * r * r / 2.0 + ms * 0.4 * r * r;
                 [across, along, across]
             }
+            // about its principal axes (see `HullShape`), at the density of `mass`
+            Shape::Hull(ref shape) => shape.hull.principal().0.map(|i| i * m / shape.hull.volume),
         }
     }
 }

@@ -156,6 +156,28 @@ fn kinematic_bodies_load_and_round_trip() {
     assert_eq!(Scene::from_json_str(&written).unwrap(), scene);
 }
 
+/// A hull's mass is its volume's at the density; its moments are about
+/// its principal axes; it is written back with its points as given; points
+/// that make no solid are refused naming them.
+#[test]
+fn hull_shapes_load_and_round_trip() {
+    let text = r#"{"bodies": [{"shape": {"type": "hull", "points": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.1, 0.1, 0.1]]},
+                   "position": [0, 1, 0]}]}"#;
+    let scene = Scene::from_json_str(text).unwrap();
+    let body = &scene.bodies[0];
+    assert!(close(body.mass, 1000.0 / 6.0), "{}", body.mass);
+    let Shape::Hull(ref h) = body.shape else { panic!("{:?}", body.shape) };
+    assert_eq!((h.points().len(), h.hull().vertices.len()), (5, 4));
+    let written = scene.to_json();
+    assert_eq!(Scene::from_json_str(&written).unwrap(), scene);
+    let flat = r#"{"bodies": [{"shape": {"type": "hull", "points": [[0, 0, 0], [1, 0, 0], [0, 0, 1], [1, 0, 1]]},
+                   "position": [0, 1, 0]}]}"#;
+    let e = error_of(flat);
+    assert!(e.contains("bodies[0].shape.points") && e.contains("span a volume"), "{e}");
+    let short = r#"{"bodies": [{"shape": {"type": "hull", "points": [[0, 0, 0], [1, 0]]}, "position": [0, 1, 0]}]}"#;
+    assert!(error_of(short).contains("bodies[0].shape.points[1]"), "{}", error_of(short));
+}
+
 #[test]
 fn body_new_uses_default_density() {
     let body = Body::new(Shape::Box { half_extents: [0.5; 3] }, [0.0, 1.0, 0.0]);

@@ -353,6 +353,8 @@ pub(super) fn check_shape(shape: &Shape, path: &str) -> Result<(), SceneError> {
             check_positive(half_height, &format!("{path}.half_height"))?;
             "radius"
         }
+        // checked as it was made (`HullShape::new`)
+        Shape::Hull(_) => "points",
     };
     let r = shape.bounding_radius();
     if r < MIN_BOUNDING_RADIUS {

@@ -53,15 +53,19 @@ pub(super) fn settings_json(s: &Settings) -> String {
 }
 
 pub(super) fn body_json(body: &Body) -> String {
-    let shape = match body.shape {
+    let shape = match &body.shape {
         Shape::Box { half_extents } => {
-            format!("{{ \"type\": \"box\", \"half_extents\": {} }}", nums(&half_extents))
+            format!("{{ \"type\": \"box\", \"half_extents\": {} }}", nums(half_extents))
         }
         Shape::Sphere { radius } => {
-            format!("{{ \"type\": \"sphere\", \"radius\": {} }}", num(radius))
+            format!("{{ \"type\": \"sphere\", \"radius\": {} }}", num(*radius))
         }
         Shape::Capsule { radius, half_height } => {
-            format!("{{ \"type\": \"capsule\", \"radius\": {}, \"half_height\": {} }}", num(radius), num(half_height))
+            format!("{{ \"type\": \"capsule\", \"radius\": {}, \"half_height\": {} }}", num(*radius), num(*half_height))
+        }
+        Shape::Hull(shape) => {
+            let points: Vec<String> = shape.points().iter().map(|p| nums(p)).collect();
+            format!("{{ \"type\": \"hull\", \"points\": [{}] }}", points.join(", "))
         }
     };
     let mut fields = vec![

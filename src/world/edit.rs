@@ -75,6 +75,7 @@ impl World {
     fn edit(&mut self, scene: Scene, keep: &[Option<usize>], removed: Option<usize>) -> Result<(), Error> {
         let n = scene.bodies.len();
         capacity::check_capacity(&self.gpu, n)?;
+        capacity::check_shapes(&scene.bodies)?;
         let joints = joint_lists(&scene);
         if scene.settings.sleeping {
             capacity::check_islands(&self.gpu, &joints, n)?;

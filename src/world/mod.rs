@@ -108,6 +108,7 @@ impl World {
         scene.validate()?;
         let n = scene.bodies.len();
         capacity::check_capacity(&gpu, n)?;
+        capacity::check_shapes(&scene.bodies)?;
         let joints = joint_lists(scene);
         if scene.settings.sleeping {
             capacity::check_islands(&gpu, &joints, n)?;

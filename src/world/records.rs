@@ -448,6 +448,8 @@ pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
         Shape::Box { half_extents: h } => ([h[0], h[1], h[2]], SHAPE_BOX),
         Shape::Sphere { radius } => ([radius, radius, radius], SHAPE_SPHERE),
         Shape::Capsule { radius, half_height } => ([radius, half_height, radius], SHAPE_CAPSULE),
+        // refused before any record is made (`check_capacity`) until hull contacts are on the GPU
+        Shape::Hull(_) => ([0.0; 3], SHAPE_BOX),
     };
     let ii = b.inverse_inertia();
     BodyProps {

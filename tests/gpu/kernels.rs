@@ -249,6 +249,7 @@ fn grid_count_bounds_each_body_by_its_move_and_turn() {
         let spin = match body.shape {
             verlet::Shape::Sphere { .. } => 0.0,
             verlet::Shape::Box { .. } | verlet::Shape::Capsule { .. } => 2.0 * turned * radius * steps,
+            verlet::Shape::Hull(_) => unreachable!("no hull in this scene"),
         };
         let world_box = match body.shape {
             verlet::Shape::Sphere { radius } => Vec3::splat(radius),
@@ -261,6 +262,7 @@ fn grid_count_bounds_each_body_by_its_move_and_turn() {
                 let r = glam::Mat3::from_quat(Quat::from_array(s.rot));
                 r.y_axis.abs() * half_height + Vec3::splat(radius)
             }
+            verlet::Shape::Hull(_) => unreachable!("no hull in this scene"),
         };
         let m = &meta[i];
         let close = |got: f32, want: f32| (got - want).abs() <= 1e-5 * want.abs().max(1.0);

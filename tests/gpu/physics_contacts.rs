@@ -47,6 +47,7 @@ fn lowest_corner(scene: &Scene, i: usize, s: &BodyOutput) -> f32 {
         Shape::Box { half_extents: h } => corners(h, s).map(|c| c.y).fold(f32::MAX, f32::min),
         Shape::Sphere { radius } => s.position[1] - radius,
         Shape::Capsule { radius, half_height } => s.position[1] - (quat(s.orientation) * Vec3::Y).y.abs() * half_height - radius,
+        Shape::Hull(_) => unreachable!("no hull in these scenes"),
     }
 }
 

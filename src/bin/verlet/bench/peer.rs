@@ -88,10 +88,14 @@ mod rapier {
                 .linear_damping(damping(s.linear_damping))
                 .angular_damping(damping(s.angular_damping))
                 .can_sleep(sleeping);
-                let shape = match b.shape {
+                let shape = match &b.shape {
                     Shape::Box { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
-                    Shape::Sphere { radius } => ColliderBuilder::ball(radius),
-                    Shape::Capsule { radius, half_height } => ColliderBuilder::capsule_y(half_height, radius),
+                    Shape::Sphere { radius } => ColliderBuilder::ball(*radius),
+                    Shape::Capsule { radius, half_height } => ColliderBuilder::capsule_y(*half_height, *radius),
+                    Shape::Hull(h) => {
+                        let points: Vec<Vector> = h.points().iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
+                        ColliderBuilder::convex_hull(&points).expect("a hull the scene accepted spans a volume")
+                    }
                 };
                 let collider =
                     material(shape.mass(b.mass), b.friction.unwrap_or(s.friction), b.restitution.unwrap_or(s.restitution));
