@@ -6,6 +6,8 @@
 //! other's most anti-parallel face against the reference face's sides and
 //! keeps up to four points, as two boxes do; an edge contact is the closest
 //! points of the two edges.
+// The elimination indexes rows and columns by number, as written.
+#![allow(clippy::needless_range_loop)]
 
 use glam::{DVec3, Quat, Vec2, Vec3};
 

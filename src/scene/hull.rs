@@ -9,6 +9,8 @@
 //! inertia come from tetrahedra from an inner point to each face's
 //! triangles, summed in f64; its principal axes from the inertia tensor by
 //! Jacobi rotations.
+// The Jacobi rotations index rows and columns by number, as written.
+#![allow(clippy::needless_range_loop)]
 
 use glam::{DMat3, DQuat, DVec3};
 
@@ -78,7 +80,7 @@ impl Hull {
             faces.push(Face { normal, offset, corners });
         }
         let (volume, centroid, inertia) = mass_properties(&vertices, &faces);
-        if !(volume > eps * extent * extent) {
+        if volume.is_nan() || volume <= eps * extent * extent {
             return Err("do not span a volume: they lie on one plane".into());
         }
         Ok(Hull { vertices, faces, volume, centroid, inertia })

@@ -99,7 +99,7 @@ fn segments_apart(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> f32 {
 }
 
 fn random_polytope(rng: &mut Rng, k: usize) -> Polytope {
-    if k % 3 == 0 {
+    if k.is_multiple_of(3) {
         let h = Vec3::new(rng.range(0.1, 0.7), rng.range(0.05, 0.7), rng.range(0.1, 0.7));
         return Polytope::from_box(h, Vec3::ZERO, rng.quat());
     }
