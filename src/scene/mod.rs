@@ -224,13 +224,17 @@ pub enum Shape {
 pub struct HullShape {
     points: Vec<[f32; 3]>,
     hull: std::sync::Arc<hull::Hull>,
+    /// Its principal moments per unit density and the turn from its
+    /// principal axes to the body's frame (`hull::Hull::principal`).
+    principal: ([f64; 3], glam::DQuat),
 }
 
 impl HullShape {
     /// The hull of `points`, or why they make none (see [`hull::Hull::new`]).
     pub fn new(points: Vec<[f32; 3]>) -> Result<HullShape, String> {
-        let hull = std::sync::Arc::new(hull::Hull::new(&points)?);
-        Ok(HullShape { points, hull })
+        let hull = hull::Hull::new(&points)?;
+        let principal = hull.principal();
+        Ok(HullShape { points, hull: std::sync::Arc::new(hull), principal })
     }
 
     /// The points as given.
@@ -305,7 +309,7 @@ impl Shape {
                 [across, along, across]
             }
             // about its principal axes (see `HullShape`), at the density of `mass`
-            Shape::Hull(ref shape) => shape.hull.principal().0.map(|i| i * m / shape.hull.volume),
+            Shape::Hull(ref shape) => shape.principal.0.map(|i| i * m / shape.hull.volume),
         }
     }
 }
@@ -358,6 +362,18 @@ impl Body {
             kinematic: false,
             restitution: None,
             friction: None,
+        }
+    }
+
+    /// Where the simulation keeps the body's pose, in the body's own frame:
+    /// a hull's centre of mass and the turn from its principal axes to the
+    /// frame (the GPU holds one diagonal inertia a body); the frame itself
+    /// for the other shapes, and for a kinematic body, which turns about
+    /// its frame's origin.
+    pub fn mass_frame(&self) -> (glam::DVec3, glam::DQuat) {
+        match &self.shape {
+            Shape::Hull(h) if !self.kinematic => (h.hull.centroid, h.principal.1),
+            _ => (glam::DVec3::ZERO, glam::DQuat::IDENTITY),
         }
     }
 

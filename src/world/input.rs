@@ -513,7 +513,7 @@ impl World {
                     let (mode, p) = match point {
                         Point::Centre => (0.0, [0.0; 3]),
                         Point::World(p) => (1.0, p),
-                        Point::Local(p) => (2.0, p),
+                        Point::Local(p) => (2.0, super::records::to_mass_frame(&self.scene.bodies[body], p)),
                     };
                     check_finite(&at("point"), &p)?;
                     check_sane(&at("point"), crate::scene::position_problem(p))?;
@@ -530,8 +530,10 @@ impl World {
                         return Err(Error::Input(format!("{}: must be a non-zero quaternion", at("orientation"))));
                     }
                     op.kind = INPUT_POSE;
-                    op.a = [position[0], position[1], position[2], 0.0];
-                    op.b = q.map(|v| (v / norm) as f32);
+                    // a hull's pose is kept at its centre of mass, on its principal axes
+                    let (pos, rot) = super::records::to_mass_pose(&self.scene.bodies[body], position, q.map(|v| (v / norm) as f32));
+                    op.a = [pos[0], pos[1], pos[2], 0.0];
+                    op.b = rot;
                 }
                 BodyInput::Velocity { linear, angular, .. } => {
                     check_finite(&at("linear"), &linear)?;

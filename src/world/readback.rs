@@ -4,7 +4,7 @@
 
 use std::mem::size_of;
 
-use super::records::body_output;
+use super::records::{body_output, from_mass_frame};
 use super::World;
 use crate::gpu::types::{BodyContact, BodyState, ContactManifold, ManifoldPoints, PairMeta};
 use crate::step::Buffer;
@@ -94,7 +94,13 @@ impl World {
             }
         }
         let gravity = self.settings.gravity;
-        let out: Vec<BodyOutput> = states.iter().zip(&not_free).map(|(s, &j)| body_output(s, dt, gravity, j)).collect();
+        let mut out: Vec<BodyOutput> = states.iter().zip(&not_free).map(|(s, &j)| body_output(s, dt, gravity, j)).collect();
+        // a hull's pose as its own frame's, not its centre of mass's and principal axes'
+        for (o, b) in out.iter_mut().zip(&self.scene.bodies) {
+            if let crate::scene::Shape::Hull(_) = b.shape {
+                (o.position, o.orientation) = from_mass_frame(b, o.position, o.orientation);
+            }
+        }
         if let Some(k) = out.iter().position(|b| !finite_output(b)) {
             return Err(Error::Diverged(format!(
                 "body {k} has a non-finite state after step {} (time {:.4} s)",

@@ -168,7 +168,7 @@ pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
     for j in &scene.joints {
         for me in 0..2 {
             if j.bodies[me] >= 0 {
-                per_body[j.bodies[me] as usize].push(joint_end(j, me));
+                per_body[j.bodies[me] as usize].push(joint_end(scene, j, me));
             }
         }
     }
@@ -240,7 +240,7 @@ pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
                 joint_done[k] = true;
                 let j = &scene.joints[k];
                 let me = if j.bodies[0] == b as i32 { 0 } else { 1 };
-                refs.push(joint_end(j, me));
+                refs.push(joint_end(scene, j, me));
                 island_order.last_mut().expect("the island begun above").push((k, b as u32));
                 let other = j.bodies[1 - me];
                 if movable(other) && !reached[other as usize] {
@@ -266,14 +266,46 @@ pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
 }
 
 /// Joint `j` seen from its end `me` (0 or 1).
-fn joint_end(j: &crate::scene::Joint, me: usize) -> JointRef {
+fn joint_end(scene: &Scene, j: &crate::scene::Joint, me: usize) -> JointRef {
     let other = j.bodies[1 - me];
+    // an anchor in its body's frame, into the frame the simulation keeps
+    let local = |k: usize| match usize::try_from(j.bodies[k]) {
+        Ok(b) => to_mass_frame(&scene.bodies[b], j.anchors[k]),
+        Err(_) => j.anchors[k],
+    };
     JointRef {
-        local_self: j.anchors[me],
+        local_self: local(me),
         partner: if other < 0 { WORLD } else { other as u32 },
-        local_partner: j.anchors[1 - me],
+        local_partner: local(1 - me),
         body: j.bodies[me] as u32,
     }
+}
+
+/// The pose of body `b`'s own frame, from the pose the simulation keeps
+/// (`Body::mass_frame`): the inverse of `initial_state`'s.
+pub(crate) fn from_mass_frame(b: &Body, position: [f32; 3], orientation: [f32; 4]) -> ([f32; 3], [f32; 4]) {
+    let (centre, axes) = b.mass_frame();
+    let o = orientation.map(|v| v as f64);
+    let frame = (DQuat::from_xyzw(o[0], o[1], o[2], o[3]) * axes.conjugate()).normalize();
+    let origin = DVec3::from_array(position.map(|v| v as f64)) - frame * centre;
+    (origin.as_vec3().to_array(), frame.as_quat().to_array())
+}
+
+/// The pose the simulation keeps for body `b` whose own frame is at
+/// `position`, turned by `orientation` (`Body::mass_frame`).
+pub(crate) fn to_mass_pose(b: &Body, position: [f32; 3], orientation: [f32; 4]) -> ([f32; 3], [f32; 4]) {
+    let (centre, axes) = b.mass_frame();
+    let o = orientation.map(|v| v as f64);
+    let frame = DQuat::from_xyzw(o[0], o[1], o[2], o[3]).normalize();
+    let pos = DVec3::from_array(position.map(|v| v as f64)) + frame * centre;
+    (pos.as_vec3().to_array(), (frame * axes).normalize().as_quat().to_array())
+}
+
+/// A point in body `b`'s own frame, in the frame the simulation keeps its
+/// pose in (`Body::mass_frame`).
+pub(crate) fn to_mass_frame(b: &Body, p: [f32; 3]) -> [f32; 3] {
+    let (centre, axes) = b.mass_frame();
+    (axes.conjugate() * (DVec3::from_array(p.map(|v| v as f64)) - centre)).as_vec3().to_array()
 }
 
 /// The joints cut into coloured paths (see `JointLists`), from the islands'
@@ -284,7 +316,7 @@ fn joint_end(j: &crate::scene::Joint, me: usize) -> JointRef {
 fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usize>]) -> (Vec<(Vec<JointRef>, bool)>, Vec<u32>) {
     let movable = |b: u32| b != WORLD && scene.bodies[b as usize].is_dynamic();
     // joint k seen from its end at body `at`
-    let end_at = |k: usize, at: u32| joint_end(&scene.joints[k], usize::from(scene.joints[k].bodies[0] != at as i32));
+    let end_at = |k: usize, at: u32| joint_end(scene, &scene.joints[k], usize::from(scene.joints[k].bodies[0] != at as i32));
     let mut taken = vec![false; scene.joints.len()];
     // the joint at body `at` (a movable one) not yet taken that goes on most
     // nearly straight from `from` (where, in its frame, the path came in;
@@ -476,9 +508,12 @@ pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
 /// Verlet then stays on the parabola. A fixed body is `HELD` (see
 /// `body_output`); no rounding remainder yet (x0 is exact).
 pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
-    let x0 = DVec3::from_array(b.position.map(|v| v as f64));
     let o = b.orientation;
-    let q0 = DQuat::from_xyzw(o[0] as f64, o[1] as f64, o[2] as f64, o[3] as f64).normalize();
+    let frame = DQuat::from_xyzw(o[0] as f64, o[1] as f64, o[2] as f64, o[3] as f64).normalize();
+    // the pose the simulation keeps (`Body::mass_frame`)
+    let (centre, axes) = b.mass_frame();
+    let x0 = DVec3::from_array(b.position.map(|v| v as f64)) + frame * centre;
+    let q0 = (frame * axes).normalize();
     let (disp, prev_q) = if b.fixed {
         (DVec3::ZERO, q0)
     } else {
@@ -498,6 +533,36 @@ pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A hull's pose is kept at its centre of mass on its principal axes, and
+    /// read back as its own frame's: out and back agree, and the kept centre
+    /// is where the frame puts the centroid.
+    #[test]
+    fn a_hulls_pose_goes_to_its_mass_frame_and_back() {
+        let points = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.5], [0.3, 0.2, 0.1]];
+        let shape = Shape::Hull(crate::scene::HullShape::new(points).unwrap());
+        let mut b = Body::new(shape, [1.0, 2.0, 3.0]);
+        b.orientation = DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0).as_quat().to_array();
+        let s = initial_state(&b, &Settings::default());
+        let (centre, axes) = b.mass_frame();
+        assert!(axes.angle_between(DQuat::IDENTITY) > 0.01, "the principal axes are not the frame's");
+        let frame = DQuat::from_array(b.orientation.map(|v| v as f64));
+        let want = DVec3::new(1.0, 2.0, 3.0) + frame * centre;
+        assert!((DVec3::from_array(s.pos.map(|v| v as f64)) - want).length() < 1e-6);
+        assert_eq!(to_mass_pose(&b, b.position, b.orientation), (s.pos, s.rot));
+        let (position, orientation) = from_mass_frame(&b, s.pos, s.rot);
+        assert!((glam::Vec3::from(position) - glam::Vec3::from(b.position)).length() < 1e-6, "{position:?}");
+        let back = glam::Quat::from_array(orientation);
+        assert!(back.angle_between(glam::Quat::from_array(b.orientation)) < 1e-5, "{orientation:?}");
+        // an anchor at the hull's corner (2, 0, 0) stays that corner in the kept frame
+        let local = glam::Vec3::from(to_mass_frame(&b, [2.0, 0.0, 0.0]));
+        let world = glam::Vec3::from(s.pos) + glam::Quat::from_array(s.rot) * local;
+        let direct = glam::Vec3::from(b.position) + glam::Quat::from_array(b.orientation) * glam::Vec3::new(2.0, 0.0, 0.0);
+        assert!((world - direct).length() < 1e-5, "{world} against {direct}");
+        // a kinematic hull keeps its own frame
+        b.kinematic = true;
+        assert_eq!(b.mass_frame(), (DVec3::ZERO, DQuat::IDENTITY));
+    }
     use crate::scene::Joint;
     use crate::scenes::{box_body, stack};
 
