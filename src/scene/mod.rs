@@ -367,13 +367,13 @@ impl Body {
 
     /// Where the simulation keeps the body's pose, in the body's own frame:
     /// a hull's centre of mass and the turn from its principal axes to the
-    /// frame (the GPU holds one diagonal inertia a body); the frame itself
-    /// for the other shapes, and for a kinematic body, which turns about
-    /// its frame's origin.
-    pub fn mass_frame(&self) -> (glam::DVec3, glam::DQuat) {
+    /// frame (the GPU holds one diagonal inertia a body). None where it is
+    /// the frame itself: the other shapes, and a kinematic body, which
+    /// turns about its frame's origin.
+    pub fn mass_frame(&self) -> Option<(glam::DVec3, glam::DQuat)> {
         match &self.shape {
-            Shape::Hull(h) if !self.kinematic => (h.hull.centroid, h.principal.1),
-            _ => (glam::DVec3::ZERO, glam::DQuat::IDENTITY),
+            Shape::Hull(h) if !self.kinematic => Some((h.hull.centroid, h.principal.1)),
+            _ => None,
         }
     }
 

@@ -284,7 +284,7 @@ fn joint_end(scene: &Scene, j: &crate::scene::Joint, me: usize) -> JointRef {
 /// The pose of body `b`'s own frame, from the pose the simulation keeps
 /// (`Body::mass_frame`): the inverse of `initial_state`'s.
 pub(crate) fn from_mass_frame(b: &Body, position: [f32; 3], orientation: [f32; 4]) -> ([f32; 3], [f32; 4]) {
-    let (centre, axes) = b.mass_frame();
+    let Some((centre, axes)) = b.mass_frame() else { return (position, orientation) };
     let o = orientation.map(|v| v as f64);
     let frame = (DQuat::from_xyzw(o[0], o[1], o[2], o[3]) * axes.conjugate()).normalize();
     let origin = DVec3::from_array(position.map(|v| v as f64)) - frame * centre;
@@ -294,7 +294,7 @@ pub(crate) fn from_mass_frame(b: &Body, position: [f32; 3], orientation: [f32; 4
 /// The pose the simulation keeps for body `b` whose own frame is at
 /// `position`, turned by `orientation` (`Body::mass_frame`).
 pub(crate) fn to_mass_pose(b: &Body, position: [f32; 3], orientation: [f32; 4]) -> ([f32; 3], [f32; 4]) {
-    let (centre, axes) = b.mass_frame();
+    let Some((centre, axes)) = b.mass_frame() else { return (position, orientation) };
     let o = orientation.map(|v| v as f64);
     let frame = DQuat::from_xyzw(o[0], o[1], o[2], o[3]).normalize();
     let pos = DVec3::from_array(position.map(|v| v as f64)) + frame * centre;
@@ -304,7 +304,7 @@ pub(crate) fn to_mass_pose(b: &Body, position: [f32; 3], orientation: [f32; 4]) 
 /// A point in body `b`'s own frame, in the frame the simulation keeps its
 /// pose in (`Body::mass_frame`).
 pub(crate) fn to_mass_frame(b: &Body, p: [f32; 3]) -> [f32; 3] {
-    let (centre, axes) = b.mass_frame();
+    let Some((centre, axes)) = b.mass_frame() else { return p };
     (axes.conjugate() * (DVec3::from_array(p.map(|v| v as f64)) - centre)).as_vec3().to_array()
 }
 
@@ -509,11 +509,13 @@ pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
 /// `body_output`); no rounding remainder yet (x0 is exact).
 pub fn initial_state(b: &Body, settings: &Settings) -> BodyState {
     let o = b.orientation;
-    let frame = DQuat::from_xyzw(o[0] as f64, o[1] as f64, o[2] as f64, o[3] as f64).normalize();
+    let mut x0 = DVec3::from_array(b.position.map(|v| v as f64));
+    let mut q0 = DQuat::from_xyzw(o[0] as f64, o[1] as f64, o[2] as f64, o[3] as f64).normalize();
     // the pose the simulation keeps (`Body::mass_frame`)
-    let (centre, axes) = b.mass_frame();
-    let x0 = DVec3::from_array(b.position.map(|v| v as f64)) + frame * centre;
-    let q0 = (frame * axes).normalize();
+    if let Some((centre, axes)) = b.mass_frame() {
+        x0 += q0 * centre;
+        q0 = (q0 * axes).normalize();
+    }
     let (disp, prev_q) = if b.fixed {
         (DVec3::ZERO, q0)
     } else {
@@ -544,7 +546,7 @@ mod tests {
         let mut b = Body::new(shape, [1.0, 2.0, 3.0]);
         b.orientation = DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0).as_quat().to_array();
         let s = initial_state(&b, &Settings::default());
-        let (centre, axes) = b.mass_frame();
+        let (centre, axes) = b.mass_frame().unwrap();
         assert!(axes.angle_between(DQuat::IDENTITY) > 0.01, "the principal axes are not the frame's");
         let frame = DQuat::from_array(b.orientation.map(|v| v as f64));
         let want = DVec3::new(1.0, 2.0, 3.0) + frame * centre;
@@ -561,7 +563,7 @@ mod tests {
         assert!((world - direct).length() < 1e-5, "{world} against {direct}");
         // a kinematic hull keeps its own frame
         b.kinematic = true;
-        assert_eq!(b.mass_frame(), (DVec3::ZERO, DQuat::IDENTITY));
+        assert_eq!(b.mass_frame(), None);
     }
     use crate::scene::Joint;
     use crate::scenes::{box_body, stack};
