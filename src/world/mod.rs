@@ -20,6 +20,8 @@ mod buffers;
 mod capacity;
 mod edit;
 mod encode;
+#[allow(dead_code)] // read by the hull narrowphase to come
+mod hull_records;
 pub mod input;
 mod pools;
 mod profile;

@@ -1,0 +1,154 @@
+//! The hulls as the GPU is to read them: one run of 16-byte words per hull
+//! shape, in the frame the simulation keeps the body's pose in
+//! (`Body::mass_frame`), shared by every body whose shape is the same.
+//!
+//! A run, from its first word:
+//!
+//! | words | what |
+//! |---|---|
+//! | 1 | counts: corners, faces, edges, and the corner indices of all faces (u32 bits) |
+//! | corners | each corner (xyz; w 0) |
+//! | faces | each face's plane: outward normal (xyz) and offset (w) |
+//! | faces | each face's run of corner indices: first, count (u32 bits in x, y) |
+//! | indices / 4, rounded up | the faces' corner indices, four to a word (u32 bits) |
+//! | edges | each edge: its two corners and its two faces (u32 bits) |
+//!
+//! A body's props will name its run's first word (`BodyProps::_pad1`).
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use crate::scene::{Body, Shape};
+
+/// The words of every hull shape of `bodies` and, for each body, the first
+/// word of its hull's run (`u32::MAX` for a body with no hull).
+pub(crate) fn hull_records(bodies: &[Body]) -> (Vec<[f32; 4]>, Vec<u32>) {
+    let mut words: Vec<[f32; 4]> = Vec::new();
+    let mut firsts = vec![u32::MAX; bodies.len()];
+    // bodies of one shape (and mass frame) share a run
+    let mut seen: HashMap<Vec<u32>, u32> = HashMap::new();
+    for (k, body) in bodies.iter().enumerate() {
+        let Shape::Hull(shape) = &body.shape else { continue };
+        let frame = body.mass_frame();
+        let mut key: Vec<u32> = shape.points().iter().flatten().map(|v| v.to_bits()).collect();
+        key.push(u32::from(frame.is_some()));
+        if let Some(&first) = seen.get(&key) {
+            firsts[k] = first;
+            continue;
+        }
+        let first = words.len() as u32;
+        seen.insert(key, first);
+        firsts[k] = first;
+        let hull = shape.hull();
+        // into the kept frame: p' = R^T (p - c)
+        let (centre, axes) = frame.unwrap_or((DVec3::ZERO, glam::DQuat::IDENTITY));
+        let to_kept = |p: DVec3| axes.conjugate() * (p - centre);
+        let bits = |v: u32| f32::from_bits(v);
+        let indices: Vec<u32> = hull.faces.iter().flat_map(|f| f.corners.iter().map(|&c| c as u32)).collect();
+        let edges = edges_of(hull);
+        words.push([
+            bits(hull.vertices.len() as u32),
+            bits(hull.faces.len() as u32),
+            bits(edges.len() as u32),
+            bits(indices.len() as u32),
+        ]);
+        for v in &hull.vertices {
+            let p = to_kept(*v);
+            words.push([p.x as f32, p.y as f32, p.z as f32, 0.0]);
+        }
+        for f in &hull.faces {
+            let n = axes.conjugate() * f.normal;
+            // the plane through the kept frame: n' . p' = offset - n . c
+            let offset = f.offset - f.normal.dot(centre);
+            words.push([n.x as f32, n.y as f32, n.z as f32, offset as f32]);
+        }
+        let mut start = 0u32;
+        for f in &hull.faces {
+            words.push([bits(start), bits(f.corners.len() as u32), 0.0, 0.0]);
+            start += f.corners.len() as u32;
+        }
+        for chunk in indices.chunks(4) {
+            let mut word = [0.0f32; 4];
+            for (w, &i) in word.iter_mut().zip(chunk) {
+                *w = bits(i);
+            }
+            words.push(word);
+        }
+        for e in edges {
+            words.push(e.map(bits));
+        }
+    }
+    (words, firsts)
+}
+
+/// Each edge of `hull` once: its two corners and the faces on either side
+/// (the first walks it from the lower corner to the higher).
+fn edges_of(hull: &crate::scene::hull::Hull) -> Vec<[u32; 4]> {
+    let mut edges = Vec::new();
+    for (f, face) in hull.faces.iter().enumerate() {
+        let c = &face.corners;
+        for k in 0..c.len() {
+            let (a, b) = (c[k], c[(k + 1) % c.len()]);
+            if a < b {
+                let other = hull
+                    .faces
+                    .iter()
+                    .position(|g| (0..g.corners.len()).any(|j| g.corners[j] == b && g.corners[(j + 1) % g.corners.len()] == a))
+                    .expect("a closed hull: every edge has a face on each side");
+                edges.push([a as u32, b as u32, f as u32, other as u32]);
+            }
+        }
+    }
+    edges
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::HullShape;
+
+    fn hull_body(points: Vec<[f32; 3]>, at: [f32; 3]) -> Body {
+        Body::new(Shape::Hull(HullShape::new(points).unwrap()), at)
+    }
+
+    /// A unit cube's run: its counts, its corners about its centre, six
+    /// planes half a metre out, their corner runs, and twelve edges with a
+    /// face on each side; a second body of the same shape shares the run,
+    /// a box none.
+    #[test]
+    fn a_cube_hull_is_one_run_shared_by_its_bodies() {
+        let cube: Vec<[f32; 3]> =
+            (0..8).map(|k| [(k & 1) as f32 - 0.5, ((k >> 1) & 1) as f32 - 0.5, ((k >> 2) & 1) as f32 - 0.5]).collect();
+        let bodies = vec![
+            hull_body(cube.clone(), [0.0; 3]),
+            crate::scenes::box_body([0.5; 3], [3.0, 0.0, 0.0]),
+            hull_body(cube, [6.0, 0.0, 0.0]),
+        ];
+        let (words, firsts) = hull_records(&bodies);
+        assert_eq!(firsts, vec![0, u32::MAX, 0]);
+        let counts = words[0].map(f32::to_bits);
+        assert_eq!(counts, [8, 6, 12, 24]);
+        let corners = &words[1..9];
+        assert!(corners.iter().all(|c| c[..3].iter().all(|v| (v.abs() - 0.5).abs() < 1e-6)), "{corners:?}");
+        let planes = &words[9..15];
+        assert!(planes
+            .iter()
+            .all(|p| (p[3] - 0.5).abs() < 1e-6 && (glam::Vec3::new(p[0], p[1], p[2]).length() - 1.0).abs() < 1e-6));
+        let runs = &words[15..21];
+        assert_eq!(runs.iter().map(|r| r[1].to_bits()).sum::<u32>(), 24);
+        let index_words = 24usize.div_ceil(4);
+        let edges = &words[21 + index_words..];
+        assert_eq!(edges.len(), 12);
+        assert!(edges.iter().all(|e| e[2].to_bits() != e[3].to_bits()));
+        // every face's corners lie on its plane
+        let indices: Vec<u32> = words[21..21 + index_words].iter().flat_map(|w| w.map(f32::to_bits)).collect();
+        for (p, r) in planes.iter().zip(runs) {
+            let (start, n) = (r[0].to_bits() as usize, r[1].to_bits() as usize);
+            for &i in &indices[start..start + n] {
+                let c = corners[i as usize];
+                assert!((p[0] * c[0] + p[1] * c[1] + p[2] * c[2] - p[3]).abs() < 1e-6);
+            }
+        }
+    }
+}
