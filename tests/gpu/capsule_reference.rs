@@ -68,6 +68,12 @@ fn true_gap(distance: f32, a: &dyn Fn(Vec3) -> f32, b: &dyn Fn(Vec3) -> f32, dir
     -dirs.iter().map(|&u| overlap_along(a, b, u)).fold(f32::MAX, f32::min)
 }
 
+/// A random point up to 1.1 `reach` from the origin, in a random direction.
+fn within(rng: &mut Rng, reach: f32) -> Vec3 {
+    let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y);
+    dir * reach * rng.range(0.0, 1.1)
+}
+
 fn random_capsule(rng: &mut Rng, at: Vec3) -> Swept {
     let long = rng.f() < 0.5;
     let radius = rng.range(0.05, 0.5);
@@ -128,13 +134,15 @@ fn capsules_against_round_shapes_keep_to_the_true_gap() {
     for k in 0..3000 {
         let a = random_capsule(&mut rng, Vec3::ZERO);
         let b = if k % 3 == 0 { Swept::sphere(Vec3::ZERO, rng.range(0.05, 0.6)) } else { random_capsule(&mut rng, Vec3::ZERO) };
-        let reach = a.half_length + a.radius + b.half_length + b.radius;
-        let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y);
-        let b = Swept { centre: dir * reach * rng.range(0.0, 1.1), ..b };
+        let b = Swept { centre: within(&mut rng, a.half_length + a.radius + b.half_length + b.radius), ..b };
         let closest = samples(&a).map(|p| to_segment(&b, p)).fold(f32::MAX, f32::min);
-        let distance = (closest - a.radius - b.radius).max(0.0);
-        let gap = true_gap(distance, &capsule_support(&a), &capsule_support(&b), &dirs);
-        let gap = if distance > 0.0 { gap } else { gap.min(closest - a.radius - b.radius) };
+        // segments apart: the gap is their distance less the radii, overlap
+        // or not; crossed: the least push over the directions
+        let gap = if closest > 1e-3 {
+            closest - a.radius - b.radius
+        } else {
+            true_gap(0.0, &capsule_support(&a), &capsule_support(&b), &dirs)
+        };
         let on_a = |p: Vec3| (to_segment(&a, p) - a.radius).max(0.0);
         let on_b = |p: Vec3| (to_segment(&b, p) - b.radius).max(0.0);
         touching += check(&format!("pair {k}"), round_round(&a, &b, MARGIN), gap, 0.0, &on_a, &on_b, &mut faults) as usize;
@@ -151,9 +159,7 @@ fn capsules_against_boxes_keep_to_the_true_gap() {
     for k in 0..3000 {
         let (bc, bq, h) = (Vec3::ZERO, rng.quat(), random_box(&mut rng));
         let capsule = random_capsule(&mut rng, Vec3::ZERO);
-        let reach = h.length() + capsule.half_length + capsule.radius;
-        let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y);
-        let capsule = Swept { centre: dir * reach * rng.range(0.0, 1.1), ..capsule };
+        let capsule = Swept { centre: within(&mut rng, h.length() + capsule.half_length + capsule.radius), ..capsule };
         let closest = samples(&capsule).map(|p| to_box(bc, bq, h, p)).fold(f32::MAX, f32::min);
         let distance = (closest - capsule.radius).max(0.0);
         let gap = true_gap(distance, &box_support(bc, bq, h), &capsule_support(&capsule), &dirs);

@@ -142,15 +142,8 @@ fn a_heap_of_capsules_settles_without_passing_through() {
 /// limbs that roll about their axes settle later than boxes do.
 #[test]
 fn ten_capsule_ragdolls_come_to_rest_on_a_pile() {
-    let scene = scenes::capsule_ragdoll(10);
-    let Some(mut w) = world(&scene) else { return };
-    let mut worst = 0.0f32;
-    for _ in 0..1800 {
-        w.step(1).unwrap();
-        worst = worst.max(verlet::world::joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max));
-    }
-    let state = w.read_state().unwrap();
-    let fastest = state.iter().map(|b| v3(b.linear_velocity).length()).fold(0.0, f32::max);
+    let widest = crate::physics_joints::widest_gap_and_fastest(&scenes::capsule_ragdoll(10), 1800);
+    let Some((worst, fastest)) = widest else { return };
     eprintln!("capsule ragdolls: worst joint gap {worst} m, fastest body after 30 s {fastest} m/s");
     assert!(worst < 0.02, "a ragdoll joint opened {worst} m");
     assert!(fastest < 0.1, "ragdolls still moving at {fastest} m/s");
