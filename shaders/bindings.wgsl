@@ -45,6 +45,9 @@ override LOOP_TRIPS: u32 = 0xffffffffu;
 // each joint island's least rest time (its bits) and whether it is held, two
 // words an island, gathered by joint_rest_gather with integer atomics
 @group(0) @binding(23) var<storage, read_write> island_rest: array<atomic<u32>>; // 2 x island count
+// the hull records (src/world/hull_records.rs): a run of words per hull
+// shape, the first the cube of half extent 1 that a box is scaled from
+@group(0) @binding(24) var<storage, read> hulls: array<vec4<f32>>;
 
 // The busiest buffers are bound as vec4 words (the same bytes as their
 // structs; tests/gpu/layouts.rs checks each pair) and read and written
@@ -91,7 +94,7 @@ struct PropsWords {
     half_extents: vec4<f32>,
     inv_inertia: vec4<f32>,
     c: vec4<u32>,   // restitution, friction (their bits), shape, flags
-    d: vec4<u32>,   // kept_inv_mass, speed_limit (their bits), grid_class, _pad1
+    d: vec4<u32>,   // kept_inv_mass, speed_limit (their bits), grid_class, hull
 }
 
 fn props_of(i: u32) -> BodyProps {
@@ -351,4 +354,81 @@ fn contact_end(i: u32) -> ContactEnd {
     return ContactEnd(s.pos, s.disp, s.rot, s.prev_rot, p.inv_inertia, r, r - quat_to_mat(s.prev_rot),
                       world_inv_inertia(r, p.inv_inertia.xyz), moves_by_contacts(s, p), is_fixed(p) || is_kinematic(p),
                       p.restitution, p.friction, radius, half_height);
+}
+
+// A convex polytope as the hull records hold it, in its body's frame: a
+// hull's run, or the unit cube's (the first run) scaled by a box's half
+// extents. Its words: counts, corners, planes, face runs, indices, edges.
+struct Poly {
+    first: u32,
+    scale: vec3<f32>,
+    corners: u32,
+    faces: u32,
+    edges: u32,
+    index_words: u32,
+}
+
+fn poly_of(p: BodyProps) -> Poly {
+    let hull = p.shape == SHAPE_HULL;
+    let first = select(0u, p.hull, hull);
+    let counts = bitcast<vec4<u32>>(hulls[first]);
+    return Poly(first, select(p.half_extents.xyz, vec3<f32>(1.0), hull), counts.x, counts.y, counts.z, (counts.w + 3u) / 4u);
+}
+
+fn poly_corner(h: Poly, k: u32) -> vec3<f32> {
+    return hulls[h.first + 1u + k].xyz * h.scale;
+}
+
+// Face f's plane: outward unit normal (xyz) and offset (w). Scaled, n / s
+// is the normal and the offset divides by its length.
+fn poly_plane(h: Poly, f: u32) -> vec4<f32> {
+    let w = hulls[h.first + 1u + h.corners + f];
+    let n = w.xyz / h.scale;
+    let inv = 1.0 / length(n);
+    return vec4<f32>(n * inv, w.w * inv);
+}
+
+// Face f's corner indices: the first's place among the indices, and the count.
+fn poly_face_run(h: Poly, f: u32) -> vec2<u32> {
+    return bitcast<vec2<u32>>(hulls[h.first + 1u + h.corners + h.faces + f].xy);
+}
+
+// The corner index at place k of the faces' runs.
+fn poly_index(h: Poly, k: u32) -> u32 {
+    let w = bitcast<vec4<u32>>(hulls[h.first + 1u + h.corners + 2u * h.faces + k / 4u]);
+    let j = k % 4u;
+    return select(select(select(w.w, w.z, j == 2u), w.y, j == 1u), w.x, j == 0u);
+}
+
+// Edge e: its two corners and the faces on either side.
+fn poly_edge(h: Poly, e: u32) -> vec4<u32> {
+    return bitcast<vec4<u32>>(hulls[h.first + 1u + h.corners + 2u * h.faces + h.index_words + e]);
+}
+
+// world_extent, for every shape: a hull's from its corners.
+fn body_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
+    if (p.shape != SHAPE_HULL) {
+        return world_extent(s, p);
+    }
+    let h = poly_of(p);
+    let r = quat_to_mat(s.rot);
+    var extent = vec3<f32>(0.0);
+    for (var k = 0u; k < h.corners; k = k + 1u) {
+        extent = max(extent, abs(r * poly_corner(h, k)));
+    }
+    return extent;
+}
+
+// reach_along, for every shape: a hull's farthest corner along dir.
+fn body_reach(p: BodyProps, rot: vec4<f32>, dir: vec3<f32>) -> f32 {
+    if (p.shape != SHAPE_HULL) {
+        return reach_along(p, rot, dir);
+    }
+    let h = poly_of(p);
+    let local = quat_rotate(quat_conj(rot), dir);
+    var reach = -3.4e38;
+    for (var k = 0u; k < h.corners; k = k + 1u) {
+        reach = max(reach, dot(local, poly_corner(h, k)));
+    }
+    return reach;
 }

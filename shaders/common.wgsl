@@ -53,7 +53,7 @@ struct BodyProps {
     kept_inv_mass: f32,      // a body an input made fixed: the inverse mass to restore (1/kg); else 0
     speed_limit: f32,        // the fastest the scene's energy can move it (m/s; see fault_of); 0: none
     grid_class: u32,         // GRID_BODY, or LARGE_BODY: kept out of the grid (see grid.wgsl)
-    _pad1: u32,
+    hull: u32,               // a hull's first word in `hulls` (bindings.wgsl)
 }
 
 // Velocities just after integration: the approach velocities restitution reflects. 32 bytes.

@@ -114,7 +114,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
     pair_meta[i].reach = reach + spin;
     pair_meta[i].spin = spin;
-    pair_meta[i].extent = world_extent(s, p) + vec3<f32>(reach + spin);
+    pair_meta[i].extent = body_extent(s, p) + vec3<f32>(reach + spin);
     // the bounding sphere turns into itself: only the centre's move grows it
     pair_meta[i].bound = p.half_extents.w + reach;
     if (!grid_body(p)) {

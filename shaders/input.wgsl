@@ -149,6 +149,10 @@ fn apply_op(op: InputOp, s_in: BodyState, p_in: ptr<function, BodyProps>) -> Bod
                 } else if (np.kept_inv_mass > 0.0 && np.kept_inv_mass != op.c.w) {
                     let kept = np.kept_inv_mass;
                     np.inv_inertia = vec4<f32>(shape_inv_inertia(p, 1.0 / kept), kept);
+                    if (p.shape == SHAPE_HULL) {
+                        // a hull's inertia scales with its mass: the scene's, rescaled
+                        np.inv_inertia = vec4<f32>(op.c.xyz * (kept / op.c.w), kept);
+                    }
                 } else {
                     np.inv_inertia = op.c;
                 }
@@ -245,7 +249,8 @@ fn explode(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// Area (m^2) of the body's shape seen along the unit world direction u.
+// Area (m^2) of the body's shape seen along the unit world direction u; a
+// hull's, that of the box about its frame's origin that holds it.
 fn projected_area(p: BodyProps, rot: vec4<f32>, u: vec3<f32>) -> f32 {
     let h = p.half_extents.xyz;
     if (p.shape == SHAPE_SPHERE) {

@@ -173,6 +173,10 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     let a = shape_of(pr.a);
     let b = shape_of(pr.b);
+    // pairs with a hull: narrowphase_hull
+    if (a.kind == SHAPE_HULL || b.kind == SHAPE_HULL) {
+        return;
+    }
     let margin = pair_margin(pr.a, pr.b);
     // each step below has one call site, so the kernel holds one copy of it
     // (lavapipe's compile time grows steeply with a kernel's size)
@@ -217,12 +221,46 @@ fn narrowphase_ground(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (pair_meta[i].owned == 0u || p >= min(atomicLoad(&status[STATUS_PAIRS]), arrayLength(&pairs)) || pairs[p].b != GROUND) {
         return;
     }
+    // a hull's: narrowphase_hull
+    if (props_of(i).shape == SHAPE_HULL) {
+        return;
+    }
     let m = ground_manifold(i, CONTACT_MARGIN + pair_meta[i].reach);
     if (m.count > 0u) {
         let slot = new_manifold(i, GROUND, false);
         if (slot != NONE) {
             store_manifold(slot, i, GROUND, p, m);
         }
+    }
+}
+
+// Pass "narrowphase_hull", after the narrowphase where a body is a hull, one
+// invocation per candidate pair: the manifolds of the pairs with a hull,
+// ground pairs too (hull.wgsl). A pass of its own, so the narrowphase's
+// vectors do not run the hulls' loops beside the boxes'.
+@compute @workgroup_size(WORKGROUP)
+fn narrowphase_hull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let p = dispatch_index(gid, groups);
+    if (p >= min(atomicLoad(&status[STATUS_PAIRS]), arrayLength(&pairs))) {
+        return;
+    }
+    let pr = pairs[p];
+    let ground = pr.b == GROUND;
+    let hull = props_of(pr.a).shape == SHAPE_HULL || (!ground && props_of(pr.b).shape == SHAPE_HULL);
+    if (!hull || (!ground && joined(pr.a, pr.b))) {
+        return;
+    }
+    var margin = CONTACT_MARGIN + pair_meta[pr.a].reach;
+    if (!ground) {
+        margin = pair_margin(pr.a, pr.b);
+    }
+    let m = collide_hull(pr.a, pr.b, margin);
+    if (m.count == 0u) {
+        return;
+    }
+    let slot = new_manifold(pr.a, pr.b, false);
+    if (slot != NONE) {
+        store_manifold(slot, pr.a, pr.b, p, m);
     }
 }
 

@@ -282,7 +282,11 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // GROUND_DEPTH in the ground is lifted to it, both poses alike. Not a
     // jointed body: its joints, closed after the sweep, would pull it back.
     if (params.has_ground != 0u && !jointed) {
-        let depth = params.ground_height - (s.pos.y - world_extent(s, p).y);
+        var lowest = s.pos.y - world_extent(s, p).y;
+        if (p.shape == SHAPE_HULL) {
+            lowest = s.pos.y - body_reach(p, s.rot, vec3<f32>(0.0, -1.0, 0.0));
+        }
+        let depth = params.ground_height - lowest;
         s.pos.y = s.pos.y + max(depth - GROUND_DEPTH, 0.0);
     }
     // The same for fixed bodies: walls and floors made of boxes stay too.
@@ -309,7 +313,7 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
     // n from this body toward its partner
     let n = select(m.normal, -m.normal, is_b);
     let o = state_of(other);
-    let overlap = dot(s.pos - o.pos, n) + reach_along(p, s.rot, n) + reach_along(props_of(other), o.rot, -n);
+    let overlap = dot(s.pos - o.pos, n) + body_reach(p, s.rot, n) + body_reach(props_of(other), o.rot, -n);
     return -n * max(overlap - GROUND_DEPTH, 0.0);
 }
 

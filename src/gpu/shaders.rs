@@ -7,6 +7,7 @@ pub const GRID: &str = include_str!("../../shaders/grid.wgsl");
 pub const PAIRS: &str = include_str!("../../shaders/pairs.wgsl");
 pub const COLLIDE: &str = include_str!("../../shaders/collide.wgsl");
 pub const CAPSULE: &str = include_str!("../../shaders/capsule.wgsl");
+pub const HULL: &str = include_str!("../../shaders/hull.wgsl");
 pub const NARROWPHASE: &str = include_str!("../../shaders/narrowphase.wgsl");
 pub const INTEGRATE: &str = include_str!("../../shaders/integrate.wgsl");
 pub const SOLVE: &str = include_str!("../../shaders/solve.wgsl");
@@ -32,6 +33,7 @@ pub fn shared_constants() -> String {
         ("SHAPE_BOX", SHAPE_BOX),
         ("SHAPE_SPHERE", SHAPE_SPHERE),
         ("SHAPE_CAPSULE", SHAPE_CAPSULE),
+        ("SHAPE_HULL", SHAPE_HULL),
         ("FLAG_FIXED", FLAG_FIXED),
         ("FLAG_KINEMATIC", FLAG_KINEMATIC),
         ("GRID_BODY", GRID_BODY),
@@ -83,7 +85,7 @@ pub fn wgsl_f32(name: &str, value: f32) -> String {
 /// The pieces of the step's passes' modules, in order (see `Stage::pieces`).
 pub(crate) const GRID_PASS: &[&str] = &[COMMON, BINDINGS, GRID];
 pub(crate) const PAIRS_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS];
-pub(crate) const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, CAPSULE, NARROWPHASE];
+pub(crate) const NARROWPHASE_PASS: &[&str] = &[COMMON, BINDINGS, GRID, PAIRS, COLLIDE, CAPSULE, HULL, NARROWPHASE];
 pub(crate) const INTEGRATE_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION, INTEGRATE];
 pub(crate) const SOLVE_PASS: &[&str] = &[COMMON, BINDINGS, SOLVE];
 pub(crate) const RESTITUTION_PASS: &[&str] = &[COMMON, BINDINGS, RESTITUTION];

@@ -54,7 +54,7 @@ pub struct BodyProps {
     pub inv_inertia: [f32; 4],
     pub restitution: f32,
     pub friction: f32,
-    /// `SHAPE_BOX`, `SHAPE_SPHERE` or `SHAPE_CAPSULE`.
+    /// `SHAPE_BOX`, `SHAPE_SPHERE`, `SHAPE_CAPSULE` or `SHAPE_HULL`.
     pub shape: u32,
     /// `FLAG_*` bits.
     pub flags: u32,
@@ -65,7 +65,9 @@ pub struct BodyProps {
     pub speed_limit: f32,
     /// `GRID_BODY`, or `LARGE_BODY` (kept out of the broadphase grid).
     pub grid_class: u32,
-    pub _pad1: u32,
+    /// A hull's first word in the hull records (src/world/hull_records.rs);
+    /// `NO_HULL` for the other shapes.
+    pub hull: u32,
 }
 
 /// Velocity after integration, before constraints (32 bytes).
@@ -302,6 +304,12 @@ pub const SHAPE_BOX: u32 = 0;
 pub const SHAPE_SPHERE: u32 = 1;
 /// A capsule: `half_extents` holds (radius, half height, radius).
 pub const SHAPE_CAPSULE: u32 = 2;
+/// A convex hull: its corners, faces and edges are in the hull records
+/// (`BodyProps::hull`); `half_extents` holds the half extents of a box about
+/// the body's origin that holds it.
+pub const SHAPE_HULL: u32 = 3;
+/// `BodyProps::hull` of a body that is not a hull.
+pub const NO_HULL: u32 = u32::MAX;
 /// `BodyProps::flags` bit: the body never moves.
 pub const FLAG_FIXED: u32 = 1;
 /// A kinematic body: moved by its own velocities alone (`Body::kinematic`).

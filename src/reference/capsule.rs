@@ -212,10 +212,14 @@ fn sign(x: f32) -> f32 {
 /// half extents h lies: the squared distance to a box is convex along a
 /// line, so a golden-section search finds its least.
 fn nearest_to_box(c: Vec3, d: Vec3, l: f32, h: Vec3) -> f32 {
-    let dist2 = |t: f32| {
-        let p = c + d * t;
-        (p - p.clamp(-h, h)).length_squared()
-    };
+    nearest_along(c, d, l, |p| (p - p.clamp(-h, h)).length_squared())
+}
+
+/// Where along the segment (c + d t, |t| <= l) the least of `dist2`, a
+/// function convex along the line (a squared distance to a convex shape),
+/// lies, by golden-section search.
+pub(crate) fn nearest_along(c: Vec3, d: Vec3, l: f32, dist2: impl Fn(Vec3) -> f32) -> f32 {
+    let dist2 = |t: f32| dist2(c + d * t);
     let ratio = 0.618_034_f32;
     let (mut lo, mut hi) = (-l, l);
     let mut x1 = hi - ratio * (hi - lo);

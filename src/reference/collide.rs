@@ -1,6 +1,6 @@
 //! Narrowphase reference (twin of `shaders/collide.wgsl`): contact
 //! manifolds between boxes and spheres, and the capsules' (`capsule.rs`)
-//! by the same rules.
+//! and hulls' (`hull.rs`) by the same rules.
 //!
 //! A manifold has one normal `n`, pointing from the first shape to the
 //! second, and up to `MAX_POINTS` pairs of points (`on_a`, `on_b`) in world
@@ -11,46 +11,82 @@
 
 use glam::{Mat3, Quat, Vec2, Vec3};
 
+use std::sync::Arc;
+
 use super::capsule::{box_capsule, round_round, Swept};
-use crate::scene::Shape;
+use super::hull::{hull_hull, hull_round, Polytope};
+use crate::scene::hull::Hull;
+use crate::scene::{Body, Shape};
 
 /// Points kept per pair: the clipped polygon (up to 8) is reduced to 4.
 pub const MAX_POINTS: usize = 4;
 
-/// A box, sphere or capsule placed in the world.
-#[derive(Clone, Copy, Debug)]
+/// A shape placed in the world.
+#[derive(Clone, Debug)]
 pub struct Placed {
     pub centre: Vec3,
     pub rot: Quat,
     pub shape: ShapeKind,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum ShapeKind {
     Box(Vec3),
     Sphere(f32),
-    Capsule { radius: f32, half_height: f32 },
+    Capsule {
+        radius: f32,
+        half_height: f32,
+    },
+    /// A hull, placed in the body's frame at `at` and turned by `rot`.
+    Hull {
+        hull: Arc<Hull>,
+        at: Vec3,
+        rot: Quat,
+    },
 }
 
+/// A shape in its body's own frame (the one the scene places).
 impl From<&Shape> for ShapeKind {
     fn from(shape: &Shape) -> ShapeKind {
         match *shape {
             Shape::Box { half_extents } => ShapeKind::Box(Vec3::from(half_extents)),
             Shape::Sphere { radius } => ShapeKind::Sphere(radius),
             Shape::Capsule { radius, half_height } => ShapeKind::Capsule { radius, half_height },
-            // hulls have their own reference (`hull.rs`); not placed as a ShapeKind yet
-            Shape::Hull(ref h) => ShapeKind::Sphere(h.hull().radius_about(h.hull().centroid) as f32),
+            Shape::Hull(ref h) => ShapeKind::Hull { hull: h.hull_arc(), at: Vec3::ZERO, rot: Quat::IDENTITY },
+        }
+    }
+}
+
+impl ShapeKind {
+    /// A body's shape in the frame the simulation keeps its pose in
+    /// (`Body::mass_frame`): a hull's moved into it.
+    pub fn kept(body: &Body) -> ShapeKind {
+        match (&body.shape, body.mass_frame()) {
+            (Shape::Hull(h), Some((centre, axes))) => {
+                let rot = axes.conjugate();
+                ShapeKind::Hull { hull: h.hull_arc(), at: (rot * -centre).as_vec3(), rot: rot.as_quat() }
+            }
+            (shape, _) => ShapeKind::from(shape),
         }
     }
 }
 
 impl Placed {
-    /// A round shape as a segment swept by its radius; None for a box.
+    /// A round shape as a segment swept by its radius; None for a box or hull.
     fn swept(&self) -> Option<Swept> {
         match self.shape {
-            ShapeKind::Box(_) => None,
             ShapeKind::Sphere(r) => Some(Swept::sphere(self.centre, r)),
             ShapeKind::Capsule { radius, half_height } => Some(Swept::capsule(self.centre, self.rot, radius, half_height)),
+            _ => None,
+        }
+    }
+
+    /// A box or hull as a polytope in the world; None for a round shape.
+    pub fn polytope(&self) -> Option<Polytope> {
+        match &self.shape {
+            ShapeKind::Box(h) => Some(Polytope::from_box(*h, self.centre, self.rot)),
+            ShapeKind::Hull { hull, at, rot } => Some(Polytope::from_hull(hull, self.centre + self.rot * *at, self.rot * *rot)),
+            _ => None,
         }
     }
 }
@@ -90,7 +126,12 @@ pub const FACE_BIAS: f32 = 0.0025;
 /// The manifold between `a` and `b`, or None when they are more than
 /// `margin` apart.
 pub fn collide(a: &Placed, b: &Placed, margin: f32) -> Option<Manifold> {
-    match (a.shape, b.shape) {
+    match (a.shape.clone(), b.shape.clone()) {
+        (ShapeKind::Hull { .. }, _) | (_, ShapeKind::Hull { .. }) => match (a.swept(), b.swept()) {
+            (None, None) => hull_hull(&a.polytope()?, &b.polytope()?, margin),
+            (None, Some(round)) => hull_round(&a.polytope()?, &round, margin),
+            (Some(round), _) => hull_round(&b.polytope()?, &round, margin).map(|m| flip(&m)),
+        },
         (ShapeKind::Sphere(ra), ShapeKind::Sphere(rb)) => sphere_sphere(a.centre, ra, b.centre, rb, margin),
         (ShapeKind::Box(h), ShapeKind::Sphere(r)) => box_sphere(a.centre, a.rot, h, b.centre, r, margin),
         (ShapeKind::Sphere(r), ShapeKind::Box(h)) => box_sphere(b.centre, b.rot, h, a.centre, r, margin).map(|m| flip(&m)),

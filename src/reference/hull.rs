@@ -6,11 +6,10 @@
 //! other's most anti-parallel face against the reference face's sides and
 //! keeps up to four points, as two boxes do; an edge contact is the closest
 //! points of the two edges.
-// The elimination indexes rows and columns by number, as written.
-#![allow(clippy::needless_range_loop)]
 
-use glam::{DVec3, Quat, Vec2, Vec3};
+use glam::{Quat, Vec2, Vec3};
 
+use super::capsule::{nearest_along, Swept, FACE_ALIGNED, SIDE_BY_SIDE};
 use super::collide::{closest_on_edges, reduce, ContactPoint, Manifold, EDGE_BIAS, FACE_BIAS};
 use crate::scene::hull::Hull;
 
@@ -117,8 +116,9 @@ fn best_edges(a: &Polytope, b: &Polytope) -> (f32, Vec3, usize, usize) {
             if len < 1e-5 * ea.length() * eb.length() {
                 continue;
             }
+            // outward from a at its edge: between the edge's face normals
             let mut l = l / len;
-            if l.dot(a.vertices[a0] - a.centre) < 0.0 {
+            if l.dot(a.faces[fa].0 + a.faces[ga].0) < 0.0 {
                 l = -l;
             }
             let sep = l.dot(b.vertices[b0] - a.vertices[a0]);
@@ -137,12 +137,29 @@ pub fn hull_hull(a: &Polytope, b: &Polytope, margin: f32) -> Option<Manifold> {
     let (sep_b, face_b) = best_face(b, a);
     let (sep_e, normal_e, edge_a, edge_b) = best_edges(a, b);
     let sep = sep_a.max(sep_b).max(sep_e);
-    // the axes' separation is the true distance's lower bound (two corners
-    // nearest each other are farther apart): where they say apart, the
-    // distance itself decides
-    if sep > margin || (sep > 0.0 && distance(&a.vertices, &b.vertices) > margin) {
+    if sep > margin {
         return None;
     }
+    let m = hull_manifold(a, b, margin, (sep_a, face_a), (sep_b, face_b), (sep_e, normal_e, edge_a, edge_b))?;
+    // the axes' separation is only a lower bound on the distance (two
+    // corners nearest each other are farther apart than any axis says):
+    // where they say apart, a pair whose points are all beyond the margin is
+    if sep > 0.0 && m.points.iter().all(|p| (p.on_b - p.on_a).length() > margin) {
+        return None;
+    }
+    Some(m)
+}
+
+/// The manifold the axes choose: a face contact unless an edge pair's axis
+/// beats the faces by `EDGE_BIAS`.
+fn hull_manifold(
+    a: &Polytope,
+    b: &Polytope,
+    margin: f32,
+    (sep_a, face_a): (f32, usize),
+    (sep_b, face_b): (f32, usize),
+    (sep_e, normal_e, edge_a, edge_b): (f32, Vec3, usize, usize),
+) -> Option<Manifold> {
     let best_face_sep = sep_a.max(sep_b);
     // b's face must beat a's by FACE_BIAS to be the reference (as for boxes)
     let flipped = sep_b > sep_a + FACE_BIAS;
@@ -255,84 +272,178 @@ fn face_contact(reference: &Polytope, face: usize, incident: &Polytope, margin: 
         .collect()
 }
 
-/// The least distance between the convex hulls of two sets of points (0
-/// where they overlap), by GJK: the point of the Minkowski difference
-/// nearest the origin, approached by simplices of its support points.
-pub fn distance(a: &[Vec3], b: &[Vec3]) -> f32 {
-    let support = |d: DVec3| {
-        let far =
-            |set: &[Vec3], d: DVec3| set.iter().map(|p| p.as_dvec3()).max_by(|p, q| p.dot(d).total_cmp(&q.dot(d))).expect("points");
-        far(a, d) - far(b, -d)
-    };
-    let mut simplex = vec![support(DVec3::X)];
-    let mut v = simplex[0];
-    for _ in 0..64 {
-        let vv = v.length_squared();
-        if vv < 1e-18 {
-            return 0.0;
-        }
-        let w = support(-v);
-        // no support point nearer the origin along -v: v is the nearest
-        if vv - v.dot(w) <= 1e-9 * vv || simplex.iter().any(|p| (*p - w).length_squared() < 1e-24) {
-            break;
-        }
-        simplex.push(w);
-        (v, simplex) = nearest_on_simplex(&simplex);
-    }
-    v.length() as f32
-}
-
-/// The point of a simplex (1 to 4 points) nearest the origin, and the
-/// smallest face of it that holds that point: over every face, the nearest
-/// point of its affine hull, kept where it lies within the face.
-fn nearest_on_simplex(points: &[DVec3]) -> (DVec3, Vec<DVec3>) {
-    let mut best: Option<(f64, DVec3, Vec<DVec3>)> = None;
-    for mask in 1u32..(1 << points.len()) {
-        let face: Vec<DVec3> = (0..points.len()).filter(|k| mask & (1 << k) != 0).map(|k| points[k]).collect();
-        let Some(x) = nearest_in_face(&face) else { continue };
-        let d = x.length_squared();
-        // fewer points for equal distances: the smallest face that holds it
-        if best.as_ref().is_none_or(|(bd, _, bf)| d < bd - 1e-18 || (d <= bd + 1e-18 && face.len() < bf.len())) {
-            best = Some((d, x, face));
-        }
-    }
-    let (_, x, face) = best.expect("a single point is always its own face");
-    (x, face)
-}
-
-/// The nearest point to the origin of the affine hull of `face`, where it
-/// lies within `face` (its weights all at least 0); None otherwise.
-fn nearest_in_face(face: &[DVec3]) -> Option<DVec3> {
-    let p0 = face[0];
-    let e: Vec<DVec3> = face[1..].iter().map(|p| *p - p0).collect();
-    let k = e.len();
-    // the normal equations G mu = -E^T p0, k <= 3, by Gaussian elimination
-    let mut m = [[0.0f64; 4]; 3];
-    for i in 0..k {
-        for j in 0..k {
-            m[i][j] = e[i].dot(e[j]);
-        }
-        m[i][3] = -e[i].dot(p0);
-    }
-    for c in 0..k {
-        let pivot = (c..k).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs()))?;
-        if m[pivot][c].abs() < 1e-18 {
-            return None;
-        }
-        m.swap(c, pivot);
-        for r in 0..k {
-            if r != c {
-                let f = m[r][c] / m[c][c];
-                for col in c..4 {
-                    m[r][col] -= f * m[c][col];
-                }
+/// The point of `p` nearest `x` (x itself inside): a face's where x's foot
+/// on its plane lies within it, else the nearest point of an edge.
+pub fn nearest_on_hull(p: &Polytope, x: Vec3) -> Vec3 {
+    let mut inside = true;
+    let (mut best, mut best_d2) = (x, f32::MAX);
+    for (f, (n, d, _)) in p.faces.iter().enumerate() {
+        let above = n.dot(x) - d;
+        if above > 0.0 {
+            inside = false;
+            let foot = x - *n * above;
+            if above * above < best_d2 && within_face(p, f, foot) {
+                (best, best_d2) = (foot, above * above);
             }
         }
     }
-    let mu: Vec<f64> = (0..k).map(|i| m[i][3] / m[i][i]).collect();
-    let first = 1.0 - mu.iter().sum::<f64>();
-    if first < -1e-9 || mu.iter().any(|&w| w < -1e-9) {
+    if inside {
+        return x;
+    }
+    for &(i, j, _, _) in &p.edges {
+        let (a, b) = (p.vertices[i], p.vertices[j]);
+        let on_edge = a + (b - a) * ((x - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+        let d2 = (on_edge - x).length_squared();
+        if d2 < best_d2 {
+            (best, best_d2) = (on_edge, d2);
+        }
+    }
+    best
+}
+
+/// Whether `x`, a point in the plane of face `face`, lies within the face.
+fn within_face(p: &Polytope, face: usize, x: Vec3) -> bool {
+    let (n, _, corners) = &p.faces[face];
+    (0..corners.len()).all(|k| {
+        let (a, b) = (p.vertices[corners[k]], p.vertices[corners[(k + 1) % corners.len()]]);
+        (b - a).cross(x - a).dot(*n) >= 0.0
+    })
+}
+
+/// A round shape against face `face` of `p`: its segment clipped to the
+/// face's sides, each end of what is left a point (on the face, on the
+/// round shape) if within `margin`; the normal is the face's.
+fn face_points(p: &Polytope, face: usize, round: &Swept, margin: f32) -> Vec<ContactPoint> {
+    let (n, d, corners) = &p.faces[face];
+    let (l, r) = (round.half_length, round.radius);
+    let p0 = round.centre - round.dir * l;
+    let e = round.dir * (2.0 * l);
+    let (mut enter, mut leave) = (0.0f32, 1.0f32);
+    for k in 0..corners.len() {
+        let (a, b) = (p.vertices[corners[k]], p.vertices[corners[(k + 1) % corners.len()]]);
+        let side = (b - a).cross(*n);
+        let (start, rate) = (side.dot(p0 - a), side.dot(e));
+        if rate == 0.0 {
+            if start > 0.0 {
+                leave = -1.0;
+            }
+        } else if rate < 0.0 {
+            enter = enter.max(-start / rate);
+        } else {
+            leave = leave.min(-start / rate);
+        }
+    }
+    if enter > leave {
+        return Vec::new();
+    }
+    let two = (leave - enter) * 2.0 * l > SIDE_BY_SIDE * r;
+    let ts = if two { vec![enter, leave] } else { vec![0.5 * (enter + leave)] };
+    ts.into_iter()
+        .map(|t| p0 + e * t)
+        .filter(|q| n.dot(*q) - d - r <= margin)
+        .map(|q| ContactPoint { on_a: q - *n * (n.dot(q) - d), on_b: q - *n * r })
+        .collect()
+}
+
+/// A hull first, a sphere or capsule second (normal from the hull), as
+/// `box_capsule`: the hull's face axes and its edges crossed with the
+/// segment; where the segment misses the hull, its nearest point says which
+/// feature meets it, and a capsule lying on a face rests on the ends of its
+/// segment clipped to the face.
+pub fn hull_round(p: &Polytope, round: &Swept, margin: f32) -> Option<Manifold> {
+    let (c, d, l, r) = (round.centre, round.dir, round.half_length, round.radius);
+    let (mut face_sep, mut face) = (f32::MIN, 0);
+    for (f, (n, off, _)) in p.faces.iter().enumerate() {
+        let sep = n.dot(c) - n.dot(d).abs() * l - off;
+        if sep > face_sep {
+            (face_sep, face) = (sep, f);
+        }
+    }
+    // the segment's edge axes: where the edge's arc crosses the circle square to it
+    let (mut edge_sep, mut edge, mut edge_n) = (f32::MIN, 0, Vec3::Y);
+    if l > 0.0 {
+        for (e, &(i, j, f1, f2)) in p.edges.iter().enumerate() {
+            let (n1, n2) = (p.faces[f1].0, p.faces[f2].0);
+            if n1.dot(d) * n2.dot(d) >= 0.0 {
+                continue;
+            }
+            let along = p.vertices[j] - p.vertices[i];
+            let axis = along.cross(d);
+            let len = axis.length();
+            if len < 1e-5 * along.length() {
+                continue;
+            }
+            let n = if axis.dot(n1 + n2) < 0.0 { -axis } else { axis } / len;
+            let sep = n.dot(c - p.vertices[i]);
+            if sep > edge_sep {
+                (edge_sep, edge, edge_n) = (sep, e, n);
+            }
+        }
+    }
+    let worst = face_sep.max(edge_sep);
+    if worst - r > margin {
         return None;
     }
-    Some(p0 + e.iter().zip(&mu).map(|(d, w)| *d * *w).sum::<DVec3>())
+    let t = if l > 0.0 { nearest_along(c, d, l, |x| (nearest_on_hull(p, x) - x).length_squared()) } else { 0.0 };
+    let on_seg = c + d * t;
+    let on_hull = nearest_on_hull(p, on_seg);
+    let out = on_seg - on_hull;
+    let dist = out.length();
+    let misses = worst > 0.0 && dist > 1e-6;
+    if misses && dist - r > margin {
+        return None;
+    }
+    let mut n = out / dist.max(1e-30);
+    // where it misses, the face its nearest point looks out of, if nearly
+    // square to it; else the face of least overlap, unless an edge's
+    let (mut aligned, mut near_face) = (-2.0f32, 0);
+    for (f, (nf, _, _)) in p.faces.iter().enumerate() {
+        if nf.dot(n) > aligned {
+            (aligned, near_face) = (nf.dot(n), f);
+        }
+    }
+    let k = if misses { near_face } else { face };
+    let along_edge = !misses && edge_sep > face_sep + EDGE_BIAS;
+    let mut points =
+        if (misses && aligned >= FACE_ALIGNED) || (!misses && !along_edge) { face_points(p, k, round, margin) } else { Vec::new() };
+    let (nk, dk, _) = &p.faces[k];
+    if !points.is_empty() || !misses {
+        n = *nk;
+    }
+    if misses && points.is_empty() {
+        points.push(ContactPoint { on_a: on_hull, on_b: on_seg - n * r });
+    }
+    if !misses && !along_edge && points.is_empty() {
+        // the segment crosses the face's plane beside the face: its end
+        // deepest along the normal, against the face's point nearest its foot
+        let low = if n.dot(d) > 0.0 { c - d * l } else { c + d * l };
+        points.push(ContactPoint { on_a: nearest_on_face(p, k, low - n * (n.dot(low) - dk)), on_b: low - n * r });
+    }
+    if along_edge {
+        n = edge_n;
+        let (i, j, _, _) = p.edges[edge];
+        let (a, b) = (p.vertices[i], p.vertices[j]);
+        let (on_edge, on_segment) = closest_on_edges((a + b) * 0.5, (b - a).normalize(), (b - a).length() * 0.5, c, d, l);
+        points = vec![ContactPoint { on_a: on_edge, on_b: on_segment - n * r }];
+    }
+    Some(Manifold { normal: n, points })
+}
+
+/// A hull's contact with the ground at height `ground` within `margin`,
+/// normal from the hull down: its corners within the margin, reduced to
+/// four as a face contact's.
+pub fn ground_hull(p: &Polytope, ground: f32, margin: f32) -> Option<Manifold> {
+    let near: Vec<Vec3> = p.vertices.iter().copied().filter(|w| w.y - ground <= margin).collect();
+    if near.is_empty() {
+        return None;
+    }
+    let candidates = near.iter().map(|w| (Vec2::new(w.z, w.x), w.y - ground)).collect();
+    let points = reduce(candidates)
+        .into_iter()
+        .map(|(at, height)| {
+            let on_b = Vec3::new(at.y, ground, at.x);
+            ContactPoint { on_a: on_b + Vec3::Y * height, on_b }
+        })
+        .collect();
+    Some(Manifold { normal: -Vec3::Y, points })
 }

@@ -243,6 +243,10 @@ impl HullShape {
     }
 
     /// The hull: its corners, faces and mass properties, in the body's frame.
+    pub fn hull_arc(&self) -> std::sync::Arc<hull::Hull> {
+        self.hull.clone()
+    }
+
     pub fn hull(&self) -> &hull::Hull {
         &self.hull
     }

@@ -32,10 +32,12 @@ pub enum Buffer {
     Snaps1 = 21,
     CellBounds = 22,
     IslandRest = 23,
+    /// The hull records (src/world/hull_records.rs).
+    Hulls = 24,
 }
 
 impl Buffer {
-    pub const ALL: [Buffer; 24] = [
+    pub const ALL: [Buffer; 25] = [
         Buffer::Params,
         Buffer::Props,
         Buffer::StateIn,
@@ -60,6 +62,7 @@ impl Buffer {
         Buffer::Snaps1,
         Buffer::CellBounds,
         Buffer::IslandRest,
+        Buffer::Hulls,
     ];
 
     pub fn binding(self) -> u32 {

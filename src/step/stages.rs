@@ -20,6 +20,7 @@ pub enum Stage {
     PairsScanSums,
     PairsWrite,
     Narrowphase,
+    NarrowphaseHull,
     NarrowphaseGround,
     ContactLists,
     NarrowphaseClip,
@@ -83,6 +84,8 @@ pub(crate) enum Poses {
 pub(crate) enum Runs {
     /// Once a step, before the substeps, in the table's order.
     EachStep,
+    /// Once a step, where a body is a hull.
+    EachStepWithHulls,
     /// Once a step, where the grid's scan spans more than one block of
     /// `SCAN_SPAN` buckets: the scan's first pass finishes a scan of one.
     EachStepOverManyBuckets,
@@ -155,7 +158,7 @@ impl StageInfo {
 }
 
 /// Every stage, in the order of `Stage` (checked as the table is built).
-pub(crate) const TABLE: [StageInfo; 23] = {
+pub(crate) const TABLE: [StageInfo; 24] = {
     use shaders::{GRID_PASS, INTEGRATE_PASS, NARROWPHASE_PASS, PAIRS_PASS, RESTITUTION_PASS, SOLVE_PASS};
     use Buffer::*;
     use Part::{Broadphase, Narrowphase};
@@ -170,7 +173,7 @@ pub(crate) const TABLE: [StageInfo; 23] = {
     const JOINT_READS: &[Buffer] = &[Params, Props, StateOut, JointStart, JointRefs];
     let table = [
         S {
-            reads: &[Params, Props, StateIn, CellCount, Status],
+            reads: &[Params, Props, StateIn, CellCount, Status, Hulls],
             writes: &[CellCount, Status, PairMeta],
             ..S::row(Stage::GridCount, "grid_count", GRID_PASS, Broadphase)
         },
@@ -243,6 +246,13 @@ pub(crate) const TABLE: [StageInfo; 23] = {
             ..S::row(Stage::Narrowphase, "narrowphase", NARROWPHASE_PASS, Narrowphase)
         },
         S {
+            over: Over::Pairs,
+            runs: Runs::EachStepWithHulls,
+            reads: &[Params, Props, StateIn, Pairs, Manifolds, Status, JointStart, JointRefs, PairMeta, BodyPairs, Points, Hulls],
+            writes: POOL_WRITES,
+            ..S::row(Stage::NarrowphaseHull, "narrowphase_hull", NARROWPHASE_PASS, Narrowphase)
+        },
+        S {
             reads: &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs, Points],
             writes: POOL_WRITES,
             ..S::row(Stage::NarrowphaseGround, "narrowphase_ground", NARROWPHASE_PASS, Narrowphase)
@@ -279,7 +289,7 @@ pub(crate) const TABLE: [StageInfo; 23] = {
             over: Over::Listed,
             poses: Poses::Flip,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds],
+            reads: &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds, Hulls],
             writes: &[StateOut],
             ..S::row(Stage::Solve, "solve", SOLVE_PASS, Part::Solve)
         },

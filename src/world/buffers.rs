@@ -41,8 +41,9 @@ pub(super) struct WorldData {
     pub props: wgpu::Buffer,
     /// What the scene fixed at start-up: the bodies kept out of the grid
     /// (copied into the tail of `sorted`, where the passes read them) and the
-    /// joint lists (the snapshot's scene hash reads them all).
-    pub statics: [wgpu::Buffer; 3],
+    /// joint lists and the hull records (the snapshot's scene hash reads
+    /// them all).
+    pub statics: [wgpu::Buffer; 4],
     /// Each joint island's two words for `joint_rest` (its least rest time
     /// and whether it is held), emptied before each use.
     pub island_rest: wgpu::Buffer,
@@ -96,6 +97,7 @@ impl WorldData {
         props: &[BodyProps],
         states: &[BodyState],
         large: &[u32],
+        hulls: &[[f32; 4]],
         joints: &JointLists,
         substeps: u32,
     ) -> WorldData {
@@ -131,12 +133,12 @@ impl WorldData {
             dispatch,
             bind_groups: None,
             props: props_buffer(device, n),
-            statics: statics_buffers(device, large, joints),
+            statics: statics_buffers(device, large, hulls, joints),
             island_rest: island_rest_buffer(device, joints),
             scratch,
             batch_start: [batch_state, storage("batch start/status", Status::BYTES)],
         };
-        data.upload(gpu, props, states, large, joints);
+        data.upload(gpu, props, states, large, hulls, joints);
         data
     }
 
@@ -148,7 +150,17 @@ impl WorldData {
     /// Params slots where the joint paths' colours need more, the rest (the
     /// contact pools, which follow the need) as they are. Takes the same
     /// handles, so nothing of this world changes until the caller writes.
-    pub(super) fn refit(&self, gpu: &Gpu, n: usize, room: usize, large: &[u32], joints: &JointLists, substeps: u32) -> WorldData {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn refit(
+        &self,
+        gpu: &Gpu,
+        n: usize,
+        room: usize,
+        large: &[u32],
+        hulls: &[[f32; 4]],
+        joints: &JointLists,
+        substeps: u32,
+    ) -> WorldData {
         let device = &gpu.device;
         let (states, batch_state, scratch, pair_meta) = if self.body_room() >= n.max(1) {
             (self.states.clone(), self.batch_start[0].clone(), self.scratch.clone(), self.pair_meta.clone())
@@ -174,7 +186,7 @@ impl WorldData {
             dispatch: self.dispatch.clone(),
             bind_groups: None,
             props: props_buffer(device, n),
-            statics: statics_buffers(device, large, joints),
+            statics: statics_buffers(device, large, hulls, joints),
             island_rest: if self.island_rest.size() >= island_rest_bytes(joints) {
                 self.island_rest.clone()
             } else {
@@ -190,7 +202,15 @@ impl WorldData {
     /// `listed_body` in bindings.wgsl), the statics, and the bodies kept
     /// out of the grid into the tail of the grid's part of `sorted`, where
     /// the passes read them.
-    pub(super) fn upload(&self, gpu: &Gpu, props: &[BodyProps], states: &[BodyState], large: &[u32], joints: &JointLists) {
+    pub(super) fn upload(
+        &self,
+        gpu: &Gpu,
+        props: &[BodyProps],
+        states: &[BodyState],
+        large: &[u32],
+        hulls: &[[f32; 4]],
+        joints: &JointLists,
+    ) {
         let queue = &gpu.queue;
         let write = |buffer: &wgpu::Buffer, at: u64, bytes: &[u8]| {
             if !bytes.is_empty() {
@@ -201,8 +221,9 @@ impl WorldData {
         for to in &self.states {
             write(to, 0, bytemuck::cast_slice(states));
         }
-        let [large_buf, joint_start, joint_refs] = &self.statics;
+        let [large_buf, joint_start, joint_refs, hull_buf] = &self.statics;
         write(large_buf, 0, bytemuck::cast_slice(large));
+        write(hull_buf, 0, bytemuck::cast_slice(hulls));
         write(joint_start, 0, bytemuck::cast_slice(&joints.starts));
         write(joint_refs, 0, bytemuck::cast_slice(&joints.refs));
         // the grid's part of `sorted` holds the other bodies, n - large of them
@@ -224,7 +245,7 @@ impl WorldData {
     /// current state (state_in) and the other the next (state_out).
     pub(crate) fn buffer(&self, buffer: Buffer, from: usize) -> &wgpu::Buffer {
         let [vel0, cell_count, cell_start, block_sums, sorted, cell_bounds] = &self.scratch;
-        let [_, joint_start, joint_refs] = &self.statics;
+        let [_, joint_start, joint_refs, hulls] = &self.statics;
         match buffer {
             Buffer::Params => &self.params,
             Buffer::Props => &self.props,
@@ -250,6 +271,7 @@ impl WorldData {
             Buffer::BodyPairs => &self.body_pairs,
             Buffer::CellBounds => cell_bounds,
             Buffer::IslandRest => &self.island_rest,
+            Buffer::Hulls => hulls,
         }
     }
 
@@ -363,11 +385,12 @@ fn island_rest_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffe
 }
 
 /// The statics (`WorldData::statics`), exactly as large as their lists.
-fn statics_buffers(device: &wgpu::Device, large: &[u32], joints: &JointLists) -> [wgpu::Buffer; 3] {
+fn statics_buffers(device: &wgpu::Device, large: &[u32], hulls: &[[f32; 4]], joints: &JointLists) -> [wgpu::Buffer; 4] {
     [
         storage_buffer(device, "grid/large", (4 * large.len()) as u64),
         storage_buffer(device, "joints/start", (4 * joints.starts.len()) as u64),
         storage_buffer(device, "joints/refs", (joints.refs.len() * size_of::<JointRef>()) as u64),
+        storage_buffer(device, "hulls", (hulls.len() * size_of::<[f32; 4]>()) as u64),
     ]
 }
 

@@ -121,14 +121,6 @@ pub fn max_bodies(gpu: &Gpu) -> u64 {
     by_state.min(by_hash).min(by_groups).min(BODY_BITS as u64 + 1)
 }
 
-/// Refuses a scene with a hull: hull contacts are not on the GPU yet.
-pub(super) fn check_shapes(bodies: &[crate::scene::Body]) -> Result<(), Error> {
-    match bodies.iter().position(|b| matches!(b.shape, crate::scene::Shape::Hull(_))) {
-        Some(k) => Err(Error::Input(format!("bodies[{k}].shape: hulls load, but this build does not simulate them yet"))),
-        None => Ok(()),
-    }
-}
-
 /// Refuses a scene of `n` bodies the adapter cannot hold, or an adapter
 /// that cannot bind a pass's buffers, before anything is allocated.
 pub(super) fn check_capacity(gpu: &Gpu, n: usize) -> Result<(), Error> {

@@ -75,7 +75,6 @@ impl World {
     fn edit(&mut self, scene: Scene, keep: &[Option<usize>], removed: Option<usize>) -> Result<(), Error> {
         let n = scene.bodies.len();
         capacity::check_capacity(&self.gpu, n)?;
-        capacity::check_shapes(&scene.bodies)?;
         let joints = joint_lists(&scene);
         if scene.settings.sleeping {
             capacity::check_islands(&self.gpu, &joints, n)?;
@@ -95,7 +94,7 @@ impl World {
         let status: Status = bytemuck::pod_read_unaligned(&read[2]);
 
         // the records of a world made for the scene, the kept bodies put back over them
-        let (mut props, large, grid) = scene_props(&scene);
+        let (mut props, large, grid, hulls) = scene_props(&scene);
         let mut states: Vec<BodyState> = Vec::with_capacity(n);
         for (k, body) in scene.bodies.iter().enumerate() {
             match keep.get(k).copied().flatten() {
@@ -104,7 +103,7 @@ impl World {
                     states.push(BodyState { rest_time: 0.0, ..old_states[from] });
                     // mass, material and the fixed flag as the user last set
                     // them; whether it sits in the grid is the edited scene's choice
-                    props[k] = BodyProps { grid_class: props[k].grid_class, ..old_props[from] };
+                    props[k] = BodyProps { grid_class: props[k].grid_class, hull: props[k].hull, ..old_props[from] };
                 }
                 None => states.push(initial_state(body, &scene.settings)),
             }
@@ -113,10 +112,10 @@ impl World {
         // outgrown buffers are made with room for half as many bodies again
         // (within what the adapter holds, checked above for n)
         let room = n.saturating_add(n / 2).min(capacity::max_bodies(&self.gpu) as usize).max(n);
-        let mut data = self.refit(n, room, &large, &joints)?;
+        let mut data = self.refit(n, room, &large, &hulls, &joints)?;
 
         // from here on nothing fails but a lost device
-        data.upload(&self.gpu, &props, &states, &large, &joints);
+        data.upload(&self.gpu, &props, &states, &large, &hulls, &joints);
         self.reset_status(&data, &status, removed);
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("edit") });
         // no body has woken another yet (`PairMeta::woken`), and no contacts
@@ -133,6 +132,7 @@ impl World {
         self.large_count = large.len() as u32;
         self.body_count = n as u32;
         self.island_count = joints.islands;
+        self.has_hulls = !hulls.is_empty();
         self.island_joints = joints.island_joints(n);
         self.path_colours = joints.colours;
         self.scene = scene;
@@ -149,11 +149,18 @@ impl World {
     /// or why they could not be had: the allocations run in an error scope
     /// of their own, so that a refusal leaves the world and its device as
     /// they were.
-    fn refit(&self, n: usize, room: usize, large: &[u32], joints: &super::records::JointLists) -> Result<WorldData, Error> {
+    fn refit(
+        &self,
+        n: usize,
+        room: usize,
+        large: &[u32],
+        hulls: &[[f32; 4]],
+        joints: &super::records::JointLists,
+    ) -> Result<WorldData, Error> {
         let device = &self.gpu.device;
         let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let data = self.data.refit(&self.gpu, n, room, large, joints, self.settings.substeps);
+        let data = self.data.refit(&self.gpu, n, room, large, hulls, joints, self.settings.substeps);
         let errors = [pollster::block_on(validation.pop()), pollster::block_on(memory.pop())];
         match errors.into_iter().flatten().next() {
             Some(e) => Err(Error::Capacity(format!(

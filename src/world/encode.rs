@@ -181,6 +181,7 @@ impl World {
         let many_blocks = |len: u32| len > SCAN_SPAN;
         let once = |s: &&Stage| match s.info().runs {
             Runs::EachStep => true,
+            Runs::EachStepWithHulls => self.has_hulls,
             Runs::EachStepOverManyBuckets => many_blocks(self.grid.hash_size),
             Runs::EachStepOverManyBodies => many_blocks(self.body_count),
             Runs::InSubsteps => false,

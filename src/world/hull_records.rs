@@ -1,6 +1,9 @@
-//! The hulls as the GPU is to read them: one run of 16-byte words per hull
-//! shape, in the frame the simulation keeps the body's pose in
-//! (`Body::mass_frame`), shared by every body whose shape is the same.
+//! The hulls as the GPU reads them (`hulls` in shaders/bindings.wgsl): one
+//! run of 16-byte words per hull shape, in the frame the simulation keeps
+//! the body's pose in (`Body::mass_frame`), shared by every body whose shape
+//! is the same. The first run is a cube of half extent 1: a box meets a hull
+//! as that cube scaled by its half extents. A scene without hulls has no
+//! records.
 //!
 //! A run, from its first word:
 //!
@@ -13,78 +16,103 @@
 //! | indices / 4, rounded up | the faces' corner indices, four to a word (u32 bits) |
 //! | edges | each edge: its two corners and its two faces (u32 bits) |
 //!
-//! A body's props will name its run's first word (`BodyProps::_pad1`).
+//! A body's props name its run's first word (`BodyProps::hull`).
 
 use std::collections::HashMap;
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 
-use crate::scene::{Body, Shape};
+use crate::gpu::types::NO_HULL;
+use crate::scene::hull::Hull;
+use crate::scene::{Body, HullShape, Shape};
 
-/// The words of every hull shape of `bodies` and, for each body, the first
-/// word of its hull's run (`u32::MAX` for a body with no hull).
+/// The corners of the cube of half extent 1, as a hull's points.
+pub(crate) fn unit_cube() -> Hull {
+    let points: Vec<[f32; 3]> = (0..8)
+        .map(|k| [if k & 1 == 0 { -1.0 } else { 1.0 }, if k & 2 == 0 { -1.0 } else { 1.0 }, if k & 4 == 0 { -1.0 } else { 1.0 }])
+        .collect();
+    Hull::new(&points).expect("a cube spans a volume")
+}
+
+/// How a hull body's points go into the frame its pose is kept in: p' =
+/// axes^-1 (p - centre) (the identity where it is the body's own frame).
+pub(crate) fn kept_frame(body: &Body) -> (DVec3, DQuat) {
+    body.mass_frame().unwrap_or((DVec3::ZERO, DQuat::IDENTITY))
+}
+
+/// A hull body's corners in the frame its pose is kept in.
+pub(crate) fn kept_corners(body: &Body, shape: &HullShape) -> Vec<DVec3> {
+    let (centre, axes) = kept_frame(body);
+    shape.hull().vertices.iter().map(|v| axes.conjugate() * (*v - centre)).collect()
+}
+
+/// The words of the unit cube and every hull shape of `bodies` and, for
+/// each body, the first word of its hull's run (`NO_HULL` for a body with
+/// no hull).
 pub(crate) fn hull_records(bodies: &[Body]) -> (Vec<[f32; 4]>, Vec<u32>) {
     let mut words: Vec<[f32; 4]> = Vec::new();
-    let mut firsts = vec![u32::MAX; bodies.len()];
+    if bodies.iter().any(|b| matches!(b.shape, Shape::Hull(_))) {
+        push_run(&mut words, &unit_cube(), DVec3::ZERO, DQuat::IDENTITY);
+    }
+    let mut firsts = vec![NO_HULL; bodies.len()];
     // bodies of one shape (and mass frame) share a run
     let mut seen: HashMap<Vec<u32>, u32> = HashMap::new();
     for (k, body) in bodies.iter().enumerate() {
         let Shape::Hull(shape) = &body.shape else { continue };
-        let frame = body.mass_frame();
         let mut key: Vec<u32> = shape.points().iter().flatten().map(|v| v.to_bits()).collect();
-        key.push(u32::from(frame.is_some()));
-        if let Some(&first) = seen.get(&key) {
-            firsts[k] = first;
-            continue;
-        }
-        let first = words.len() as u32;
-        seen.insert(key, first);
-        firsts[k] = first;
-        let hull = shape.hull();
-        // into the kept frame: p' = R^T (p - c)
-        let (centre, axes) = frame.unwrap_or((DVec3::ZERO, glam::DQuat::IDENTITY));
-        let to_kept = |p: DVec3| axes.conjugate() * (p - centre);
-        let bits = |v: u32| f32::from_bits(v);
-        let indices: Vec<u32> = hull.faces.iter().flat_map(|f| f.corners.iter().map(|&c| c as u32)).collect();
-        let edges = edges_of(hull);
-        words.push([
-            bits(hull.vertices.len() as u32),
-            bits(hull.faces.len() as u32),
-            bits(edges.len() as u32),
-            bits(indices.len() as u32),
-        ]);
-        for v in &hull.vertices {
-            let p = to_kept(*v);
-            words.push([p.x as f32, p.y as f32, p.z as f32, 0.0]);
-        }
-        for f in &hull.faces {
-            let n = axes.conjugate() * f.normal;
-            // the plane through the kept frame: n' . p' = offset - n . c
-            let offset = f.offset - f.normal.dot(centre);
-            words.push([n.x as f32, n.y as f32, n.z as f32, offset as f32]);
-        }
-        let mut start = 0u32;
-        for f in &hull.faces {
-            words.push([bits(start), bits(f.corners.len() as u32), 0.0, 0.0]);
-            start += f.corners.len() as u32;
-        }
-        for chunk in indices.chunks(4) {
-            let mut word = [0.0f32; 4];
-            for (w, &i) in word.iter_mut().zip(chunk) {
-                *w = bits(i);
-            }
-            words.push(word);
-        }
-        for e in edges {
-            words.push(e.map(bits));
-        }
+        key.push(u32::from(body.mass_frame().is_some()));
+        firsts[k] = *seen.entry(key).or_insert_with(|| {
+            let first = words.len() as u32;
+            let (centre, axes) = kept_frame(body);
+            push_run(&mut words, shape.hull(), centre, axes);
+            first
+        });
     }
     (words, firsts)
 }
 
+/// Appends the run of `hull` moved into the frame at `centre` with axes `axes`.
+fn push_run(words: &mut Vec<[f32; 4]>, hull: &Hull, centre: DVec3, axes: DQuat) {
+    let to_kept = |p: DVec3| axes.conjugate() * (p - centre);
+    let bits = |v: u32| f32::from_bits(v);
+    let indices: Vec<u32> = hull.faces.iter().flat_map(|f| f.corners.iter().map(|&c| c as u32)).collect();
+    let edges = edges_of(hull);
+    words.push([
+        bits(hull.vertices.len() as u32),
+        bits(hull.faces.len() as u32),
+        bits(edges.len() as u32),
+        bits(indices.len() as u32),
+    ]);
+    for v in &hull.vertices {
+        let p = to_kept(*v);
+        words.push([p.x as f32, p.y as f32, p.z as f32, 0.0]);
+    }
+    for f in &hull.faces {
+        let n = axes.conjugate() * f.normal;
+        // the plane through the kept frame: n' . p' = offset - n . c
+        let offset = f.offset - f.normal.dot(centre);
+        words.push([n.x as f32, n.y as f32, n.z as f32, offset as f32]);
+    }
+    let mut start = 0u32;
+    for f in &hull.faces {
+        words.push([bits(start), bits(f.corners.len() as u32), 0.0, 0.0]);
+        start += f.corners.len() as u32;
+    }
+    for chunk in indices.chunks(4) {
+        let mut word = [0.0f32; 4];
+        for (w, &i) in word.iter_mut().zip(chunk) {
+            *w = bits(i);
+        }
+        words.push(word);
+    }
+    for e in edges {
+        words.push(e.map(bits));
+    }
+}
+
 /// Each edge of `hull` once: its two corners and the faces on either side
 /// (the first walks it from the lower corner to the higher).
-fn edges_of(hull: &crate::scene::hull::Hull) -> Vec<[u32; 4]> {
+pub(crate) fn edges_of(hull: &Hull) -> Vec<[u32; 4]> {
     let mut edges = Vec::new();
     for (f, face) in hull.faces.iter().enumerate() {
         let c = &face.corners;
@@ -126,7 +154,11 @@ mod tests {
             hull_body(cube, [6.0, 0.0, 0.0]),
         ];
         let (words, firsts) = hull_records(&bodies);
-        assert_eq!(firsts, vec![0, u32::MAX, 0]);
+        let cube_run = firsts[0] as usize;
+        assert_eq!(firsts, vec![firsts[0], NO_HULL, firsts[0]]);
+        // the unit cube's run comes first, as long as this one
+        assert_eq!(cube_run * 2, words.len());
+        let words = &words[cube_run..];
         let counts = words[0].map(f32::to_bits);
         assert_eq!(counts, [8, 6, 12, 24]);
         let corners = &words[1..9];

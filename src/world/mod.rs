@@ -64,6 +64,8 @@ pub struct World {
     /// Joint islands (`joint_rest` and `solve_joints` run only when there
     /// are any).
     island_count: u32,
+    /// Whether a body is a hull: the step then runs `narrowphase_hull`.
+    has_hulls: bool,
     /// The joints of the islands' lists: `joint_rest` runs one invocation
     /// for each.
     island_joints: u32,
@@ -110,15 +112,14 @@ impl World {
         scene.validate()?;
         let n = scene.bodies.len();
         capacity::check_capacity(&gpu, n)?;
-        capacity::check_shapes(&scene.bodies)?;
         let joints = joint_lists(scene);
         if scene.settings.sleeping {
             capacity::check_islands(&gpu, &joints, n)?;
         }
         let settings = scene.settings;
-        let (props, large, grid) = scene_props(scene);
+        let (props, large, grid, hulls) = scene_props(scene);
         let states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &settings)).collect();
-        let mut data = WorldData::new(&gpu, n, &props, &states, &large, &joints, settings.substeps);
+        let mut data = WorldData::new(&gpu, n, &props, &states, &large, &hulls, &joints, settings.substeps);
         let (_, manifold_capacity) = pair_capacities(&gpu, n.max(1) as u64);
         let pipelines = StepPipelines::new(&gpu, capacity::pool_in_parts(&gpu, manifold_capacity));
         data.bind_groups = Some(data.step_bind_groups(&gpu.device, &pipelines));
@@ -134,6 +135,7 @@ impl World {
             large_count: large.len() as u32,
             body_count: n as u32,
             island_count: joints.islands,
+            has_hulls: !hulls.is_empty(),
             island_joints: joints.island_joints(n),
             path_colours: joints.colours.clone(),
             speed_limits: true,

@@ -423,9 +423,13 @@ pub fn joint_gaps(scene: &Scene, states: &[BodyState]) -> Vec<f32> {
 }
 
 /// Every body's GPU record, the bodies kept out of the grid (`LARGE_BODY` in
-/// their records) and the grid for the rest.
-pub(crate) fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout) {
+/// their records), the grid for the rest, and the hull records.
+pub(crate) fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayout, Vec<[f32; 4]>) {
     let mut props: Vec<BodyProps> = scene.bodies.iter().map(|b| body_props(b, &scene.settings)).collect();
+    let (hulls, firsts) = super::hull_records::hull_records(&scene.bodies);
+    for (p, first) in props.iter_mut().zip(firsts) {
+        p.hull = first;
+    }
     for (p, limit) in props.iter_mut().zip(speed_limits(scene)) {
         p.speed_limit = limit;
     }
@@ -434,7 +438,7 @@ pub(crate) fn scene_props(scene: &Scene) -> (Vec<BodyProps>, Vec<u32>, GridLayou
     for &i in &large {
         props[i as usize].grid_class = LARGE_BODY;
     }
-    (props, large, grid)
+    (props, large, grid, hulls)
 }
 
 /// Each body's speed limit (m/s, `BodyProps::speed_limit`; 0: none): twice
@@ -476,16 +480,23 @@ pub(crate) fn speed_limits(scene: &Scene) -> Vec<f32> {
 
 /// The GPU record of a body's shape, mass and material.
 pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
+    let mut radius = b.bounding_radius();
     let (half, shape) = match b.shape {
         Shape::Box { half_extents: h } => ([h[0], h[1], h[2]], SHAPE_BOX),
         Shape::Sphere { radius } => ([radius, radius, radius], SHAPE_SPHERE),
         Shape::Capsule { radius, half_height } => ([radius, half_height, radius], SHAPE_CAPSULE),
-        // refused before any record is made (`check_capacity`) until hull contacts are on the GPU
-        Shape::Hull(_) => ([0.0; 3], SHAPE_BOX),
+        Shape::Hull(ref h) => {
+            // about the origin of the frame the pose is kept in, which a
+            // kinematic hull's points need not surround
+            let corners = super::hull_records::kept_corners(b, h);
+            let half = corners.iter().fold(DVec3::ZERO, |m, c| m.max(c.abs()));
+            radius = corners.iter().map(|c| c.length()).fold(0.0, f64::max) as f32;
+            ([half.x as f32, half.y as f32, half.z as f32], SHAPE_HULL)
+        }
     };
     let ii = b.inverse_inertia();
     BodyProps {
-        half_extents: [half[0], half[1], half[2], b.bounding_radius()],
+        half_extents: [half[0], half[1], half[2], radius],
         inv_inertia: [ii[0], ii[1], ii[2], b.inverse_mass()],
         restitution: b.restitution.unwrap_or(settings.restitution),
         friction: b.friction.unwrap_or(settings.friction),
@@ -498,6 +509,7 @@ pub(crate) fn body_props(b: &Body, settings: &Settings) -> BodyProps {
             0
         },
         grid_class: GRID_BODY,
+        hull: NO_HULL,
         ..Default::default()
     }
 }

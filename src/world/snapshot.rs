@@ -64,7 +64,7 @@
 use std::path::Path;
 
 use super::World;
-use crate::gpu::types::{BodyProps, BodyState, PairMeta, HELD, WAKES, WOKEN_LAST, WOKEN_NOW};
+use crate::gpu::types::{BodyProps, BodyState, PairMeta, HELD, SHAPE_HULL, WAKES, WOKEN_LAST, WOKEN_NOW};
 use crate::Error;
 
 const MAGIC: &[u8; 8] = b"VRLTSNAP";
@@ -465,7 +465,9 @@ impl World {
         for p in &props {
             put(&hashed_props(p));
         }
-        for buf in &self.data.statics {
+        // the hull records where there are hulls (a scene without keeps the hash it had)
+        let hulls = props.iter().any(|p| p.shape == SHAPE_HULL);
+        for buf in &self.data.statics[..if hulls { 4 } else { 3 }] {
             put(&self.gpu.read_buffer(buf, buf.size())?);
         }
         Ok(h)
@@ -494,7 +496,7 @@ fn hashed_props(p: &BodyProps) -> [u8; 64] {
         p.shape,
         p.flags,
         p.grid_class,
-        p._pad1,
+        p.hull,
     ];
     let mut bytes = [0u8; 64];
     for (out, w) in bytes.chunks_exact_mut(4).zip(words) {

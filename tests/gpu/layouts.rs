@@ -41,7 +41,7 @@ fn shared_structs_match_member_by_member() {
     check_layout!(common, BodyState { pos, rest_time, disp, pos_low, rot, prev_rot });
     check_layout!(
         common,
-        BodyProps { half_extents, inv_inertia, restitution, friction, shape, flags, kept_inv_mass, speed_limit, grid_class, _pad1 }
+        BodyProps { half_extents, inv_inertia, restitution, friction, shape, flags, kept_inv_mass, speed_limit, grid_class, hull }
     );
     check_layout!(common, Velocity { linear, angular });
     check_layout!(

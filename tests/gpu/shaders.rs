@@ -94,6 +94,7 @@ fn every_loop_counts_to_a_bound() {
         ("pairs.wgsl", shaders::PAIRS.to_string()),
         ("collide.wgsl", shaders::COLLIDE.to_string()),
         ("capsule.wgsl", shaders::CAPSULE.to_string()),
+        ("hull.wgsl", shaders::HULL.to_string()),
         ("narrowphase.wgsl", shaders::NARROWPHASE.to_string()),
         ("integrate.wgsl", shaders::INTEGRATE.to_string()),
         ("solve.wgsl", shaders::SOLVE.to_string()),
