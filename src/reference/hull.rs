@@ -68,6 +68,15 @@ impl Polytope {
         Polytope { vertices, faces, edges, centre }
     }
 
+    /// The polytope moved by `by`.
+    pub fn moved(&self, by: Vec3) -> Polytope {
+        let mut q = self.clone();
+        q.vertices.iter_mut().for_each(|v| *v += by);
+        q.faces.iter_mut().for_each(|f| f.1 += f.0.dot(by));
+        q.centre += by;
+        q
+    }
+
     /// The least of `n . v` over the corners: how far the polytope reaches
     /// against n.
     fn lowest_along(&self, n: Vec3) -> f32 {
@@ -351,6 +360,16 @@ fn face_points(p: &Polytope, face: usize, round: &Swept, margin: f32) -> Vec<Con
 /// feature meets it, and a capsule lying on a face rests on the ends of its
 /// segment clipped to the face.
 pub fn hull_round(p: &Polytope, round: &Swept, margin: f32) -> Option<Manifold> {
+    // about the hull's centre, as the GPU works in its frame: far from the
+    // origin, f32 would blur the flat least the search along the segment seeks
+    let o = p.centre;
+    let near = p.moved(-o);
+    let m = hull_round_near(&near, &Swept { centre: round.centre - o, ..*round }, margin)?;
+    let points = m.points.iter().map(|q| ContactPoint { on_a: q.on_a + o, on_b: q.on_b + o }).collect();
+    Some(Manifold { normal: m.normal, points })
+}
+
+fn hull_round_near(p: &Polytope, round: &Swept, margin: f32) -> Option<Manifold> {
     let (c, d, l, r) = (round.centre, round.dir, round.half_length, round.radius);
     let (mut face_sep, mut face) = (f32::MIN, 0);
     for (f, (n, off, _)) in p.faces.iter().enumerate() {

@@ -29,7 +29,7 @@ pub struct BodyOutput {
 impl World {
     /// The contact points of every body as it sees them, from the last
     /// step's narrowphase, in its pair order (a blocking readback, for tests
-    /// and debugging).
+    /// and debugging); local points in each body's own frame.
     pub fn read_contacts(&self) -> Result<Vec<Vec<BodyContact>>, Error> {
         let n = self.body_count as usize;
         if self.skipped {
@@ -44,6 +44,11 @@ impl World {
         for part in &self.data.points {
             points.extend(bytemuck::pod_collect_to_vec::<u8, ManifoldPoints>(&read(part)?));
         }
+        // a point in the frame a body's pose is kept in, into its own
+        let own = |body: u32, p: [f32; 3]| match self.scene.bodies.get(body as usize).and_then(|b| b.mass_frame()) {
+            Some((centre, axes)) => (centre + axes * glam::DVec3::from_array(p.map(f64::from))).as_vec3().to_array(),
+            None => p,
+        };
         let mut out = vec![Vec::new(); n];
         for (i, list) in out.iter_mut().enumerate() {
             // contact references (shaders/narrowphase.wgsl's contact_lists)
@@ -55,6 +60,7 @@ impl World {
                 for pt in &p.at[..m.count as usize] {
                     let (local_self, partner, local_partner, sign) =
                         if me_a { (pt.local_a, m.b, pt.local_b, -1.0) } else { (pt.local_b, m.a, pt.local_a, 1.0) };
+                    let (local_self, local_partner) = (own(i as u32, local_self), own(partner, local_partner));
                     list.push(BodyContact { local_self, partner, local_partner, normal: m.normal.map(|v| v * sign) });
                 }
             }

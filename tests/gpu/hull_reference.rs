@@ -112,14 +112,6 @@ fn random_polytope(rng: &mut Rng, k: usize) -> Polytope {
     Polytope::from_hull(&Hull::new(&points).unwrap(), Vec3::ZERO, rng.quat())
 }
 
-fn moved(p: &Polytope, by: Vec3) -> Polytope {
-    let mut q = p.clone();
-    q.vertices.iter_mut().for_each(|v| *v += by);
-    q.faces.iter_mut().for_each(|f| f.1 += f.0.dot(by));
-    q.centre += by;
-    q
-}
-
 #[test]
 fn hulls_keep_to_the_true_gap() {
     let mut rng = Rng(0x4011_5eed_0000_0001);
@@ -129,7 +121,7 @@ fn hulls_keep_to_the_true_gap() {
         let b = random_polytope(&mut rng, k + 1);
         let reach = |p: &Polytope| p.vertices.iter().map(|v| (*v - p.centre).length()).fold(0.0, f32::max);
         let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y);
-        let b = moved(&b, a.centre - b.centre + dir * (reach(&a) + reach(&b)) * rng.range(0.0, 0.9));
+        let b = b.moved(a.centre - b.centre + dir * (reach(&a) + reach(&b)) * rng.range(0.0, 0.9));
         let gap = true_gap(&a, &b);
         let m = hull_hull(&a, &b, MARGIN);
         let Some(m) = m else {

@@ -1,15 +1,18 @@
 //! The GPU narrowphase gives the CPU reference's manifolds: random pairs of
 //! boxes and spheres (thin slabs and needles among them), each pair far from
-//! the others, one step, contacts read back and compared point by point.
+//! the others, one step, contacts read back and compared point by point;
+//! capsules and hulls against every shape, and hulls on the ground.
 
 use crate::common::world;
 use crate::common::Rng;
 use glam::{Quat, Vec3};
 use verlet::limits::CONTACT_MARGIN;
 use verlet::reference::collide::{collide, Placed, ShapeKind};
+use verlet::reference::hull::ground_hull;
+use verlet::scene::HullShape;
 use verlet::scenes::{box_body, sphere_body};
 use verlet::world::initial_state;
-use verlet::{Body, Scene, Settings, Shape};
+use verlet::{Body, Ground, Scene, Settings, Shape};
 
 fn random_body(rng: &mut Rng, k: usize, at: Vec3) -> Body {
     let mut b = match k % 5 {
@@ -22,9 +25,14 @@ fn random_body(rng: &mut Rng, k: usize, at: Vec3) -> Body {
     b
 }
 
+/// A body as the reference places it: a hull in its own frame, as the
+/// contacts read back are; any other at the pose the GPU starts from.
 fn placed(b: &Body, settings: &Settings) -> Placed {
-    let s = initial_state(b, settings);
     let shape = ShapeKind::from(&b.shape);
+    if let Shape::Hull(_) = b.shape {
+        return Placed { centre: Vec3::from_array(b.position), rot: Quat::from_array(b.orientation).normalize(), shape };
+    }
+    let s = initial_state(b, settings);
     Placed { centre: Vec3::from_array(s.pos), rot: Quat::from_array(s.rot), shape }
 }
 
@@ -112,4 +120,75 @@ fn gpu_capsule_manifolds_match_the_cpu_reference() {
     // two, the end of a golden-section search on a flat least) may go
     // either way; anything beyond such rare ties is a bug
     assert!(mismatched.len() <= 4, "{} of 400 pairs differ from the reference", mismatched.len());
+}
+
+/// A hull of 4 to 32 random points in a box of random size, its points
+/// off centre so that its frame is not its centre of mass.
+pub fn random_hull(rng: &mut Rng, at: Vec3) -> Body {
+    let scale = Vec3::new(0.3 + 0.7 * rng.f(), 0.3 + 0.7 * rng.f(), 0.3 + 0.7 * rng.f());
+    let off = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5) * 0.3;
+    let n = 4 + (rng.f() * 28.0) as usize;
+    let points = (0..n).map(|_| (Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5) * scale + off).to_array()).collect();
+    let mut b = Body::new(Shape::Hull(HullShape::new(points).unwrap()), at.to_array());
+    b.orientation = rng.quat().to_array();
+    b
+}
+
+/// A hull, or a body of `random_with_capsule` (a capsule, sphere or box).
+fn random_with_hull(rng: &mut Rng, k: usize, at: Vec3) -> Body {
+    if k.is_multiple_of(3) {
+        return random_with_capsule(rng, k, at);
+    }
+    random_hull(rng, at)
+}
+
+#[test]
+fn gpu_hull_manifolds_match_the_cpu_reference() {
+    let Some((touching, mismatched)) = compare(0x5eed_4011_0000_0003, 400, random_with_hull) else { return };
+    assert!(touching > 150, "too few touching pairs to compare: {touching}");
+    // f32 on two processors: a near tie (a face or an edge, which corner is
+    // deepest, the end of a golden-section search) may go either way
+    assert!(mismatched.len() <= 4, "{} of 400 pairs differ from the reference", mismatched.len());
+}
+
+/// Hulls at random turns just above, on and in the ground: the GPU's ground
+/// points are the reference's.
+#[test]
+fn gpu_hull_ground_manifolds_match_the_cpu_reference() {
+    let settings = Settings { gravity: [0.0; 3], ..Settings::default() };
+    let mut rng = Rng(0x5eed_4011_0000_0004);
+    let mut bodies = Vec::new();
+    for k in 0..200 {
+        let mut b = random_hull(&mut rng, Vec3::new((k % 20) as f32 * 5.0, 0.0, (k / 20) as f32 * 5.0));
+        let p = placed(&b, &settings).polytope().unwrap();
+        let lowest = p.vertices.iter().map(|v| v.y).fold(f32::MAX, f32::min);
+        b.position[1] += rng.f() * 0.07 - 0.05 - lowest;
+        bodies.push(b);
+    }
+    let scene = Scene { settings, ground: Some(Ground { height: 0.0 }), bodies, joints: vec![], camera: None };
+    let Some(mut w) = world(&scene) else { return };
+    w.step(1).unwrap();
+    let contacts = w.read_contacts().unwrap();
+    let (mut touching, mut mismatched) = (0, Vec::new());
+    for (k, b) in scene.bodies.iter().enumerate() {
+        let pa = placed(b, &settings);
+        let cpu = ground_hull(&pa.polytope().unwrap(), 0.0, CONTACT_MARGIN);
+        let gpu = &contacts[k];
+        let Some(m) = cpu else {
+            if !gpu.is_empty() {
+                mismatched.push(format!("hull {k}: GPU {} points, CPU none", gpu.len()));
+            }
+            continue;
+        };
+        touching += 1;
+        let found = gpu.iter().all(|c| {
+            let on_a = pa.centre + pa.rot * Vec3::from(c.local_self);
+            m.points.iter().any(|q| (q.on_a - on_a).length() < 2e-3)
+        });
+        if gpu.len() != m.points.len() || !found {
+            mismatched.push(format!("hull {k}: GPU {} points, CPU {}", gpu.len(), m.points.len()));
+        }
+    }
+    assert!(touching > 100, "too few touching: {touching}");
+    assert!(mismatched.len() <= 2, "{} of 200 differ: {mismatched:?}", mismatched.len());
 }
