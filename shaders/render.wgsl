@@ -1,7 +1,8 @@
 // Off-screen rendering of a world (host code: src/render/mod.rs). The bodies are
 // drawn straight from the world's current state buffer, bound read-only: one
-// instance per body, a unit mesh (cube or icosphere) scaled, turned and moved
-// to its centre in the vertex shader, so nothing is read back to draw.
+// instance per body, a unit mesh (cube or icosphere) scaled, or a hull's own
+// mesh, turned and moved to its centre in the vertex shader, so nothing is
+// read back to draw.
 //
 // Two passes, four pipelines, all reading bind group 0:
 //   shadow_vertex                    the bodies' depth as the sun sees them
@@ -12,7 +13,8 @@
 // (near = 1, far = 0, infinite far plane), so a 32-bit float depth buffer
 // keeps its precision from the near plane to the horizon.
 
-// BodyState, quat_rotate and SHAPE_* come from common.wgsl and the shared constants.
+// BodyState, quat_rotate and SHAPE_* come from common.wgsl and the shared
+// constants; HULL_MESH is the renderer's own, written before common.wgsl.
 
 // The renderer's constants (208 bytes), written once; `Globals` in src/render/gpu.rs.
 struct Globals {
@@ -33,16 +35,18 @@ struct Globals {
 }
 
 // One drawn body (32 bytes); `RenderBody` in src/render/gpu.rs. Boxes come
-// first, then spheres and capsules (both drawn from the sphere's mesh), so
+// first, then spheres and capsules (both drawn from the sphere's mesh), then
+// hulls by shape (each shape its mesh, in the frame the pose is kept in), so
 // each mesh is one instanced draw over a range.
 struct RenderBody {
-    // box: half extents (m); sphere: the radius in all three; capsule: (radius, half height, radius)
+    // box: half extents (m); sphere: the radius in all three; capsule: (radius, half height, radius);
+    // hull: 1 in all three (its mesh is in metres)
     half_extents: vec3<f32>,
     // index of the body in the state buffer
     body: u32,
     // linear RGB
     color: vec3<f32>,
-    // SHAPE_BOX, SHAPE_SPHERE or SHAPE_CAPSULE
+    // SHAPE_BOX, SHAPE_SPHERE, SHAPE_CAPSULE or HULL_MESH
     shape: u32,
 }
 
@@ -103,8 +107,9 @@ fn body_point(mesh_pos: vec3<f32>, b: RenderBody) -> vec3<f32> {
     return s.pos + quat_rotate(normalize(s.rot), mesh_local(mesh_pos, b));
 }
 
-// A unit mesh point in the body's frame: scaled to a box or a sphere; a
-// capsule is the sphere's halves moved half its height apart along y.
+// A mesh point in the body's frame: a unit mesh scaled to a box or a sphere
+// (a hull's, by 1); a capsule is the sphere's halves moved half its height
+// apart along y.
 fn mesh_local(mesh_pos: vec3<f32>, b: RenderBody) -> vec3<f32> {
     if b.shape == SHAPE_CAPSULE {
         let r = b.half_extents.x;
@@ -145,7 +150,8 @@ fn body_vertex(
     out.clip = globals.view_proj * vec4<f32>(world, 1.0);
     out.world_pos = world;
     // a box's face normals and a sphere's normals survive its (axis-aligned or
-    // uniform) scale; a capsule's halves keep theirs, and its sides go between
+    // uniform) scale; a capsule's halves keep theirs, and its sides go between;
+    // a hull's faces are unscaled
     out.world_normal = quat_rotate(q, mesh_normal);
     out.local_pos = local;
     out.half_extents = b.half_extents;
@@ -167,11 +173,12 @@ fn body_fragment(in: BodyOut) -> @location(0) vec4<f32> {
     let l = in.local_pos;
     let octant = select(0.0, 1.0, l.x * l.y * l.z < 0.0);
     var albedo = in.color;
-    if in.shape != SHAPE_BOX {
-        albedo = mix(albedo, vec3<f32>(1.0), 0.5 * octant);
-    } else {
+    if in.shape == SHAPE_BOX {
         albedo = albedo * (1.0 - 0.5 * edge);
+    } else if in.shape != HULL_MESH {
+        albedo = mix(albedo, vec3<f32>(1.0), 0.5 * octant);
     }
+    // a hull keeps its colour: its flat faces already read apart, and turn with it
     return vec4<f32>(shade(albedo, n, in.world_pos), 1.0);
 }
 

@@ -3,11 +3,11 @@
 //! frame's constants that follow from them (the sun's view for shadows,
 //! fog and grid spacing). Maths only; `gpu.rs` uploads the result.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Quat, Vec3};
 
 use super::bodies::{srgb_to_linear, BACKGROUND_SRGB};
 use super::gpu::Globals;
-use crate::scene::{Scene, DEFAULT_FOV_Y};
+use crate::scene::{Scene, Shape, DEFAULT_FOV_Y};
 
 /// The shadow map covers the scene's starting bounding sphere times this,
 /// so bodies that roll or swing a little out of it still cast shadows.
@@ -51,7 +51,11 @@ fn framing(scene: &Scene) -> Framing {
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for b in &scene.bodies {
-        let p = Vec3::from_array(b.position);
+        let mut p = Vec3::from_array(b.position);
+        // a hull's bounding radius is about its centre of mass, which may lie off its frame's origin
+        if let Shape::Hull(h) = &b.shape {
+            p += Quat::from_array(b.orientation).normalize() * h.hull().centroid.as_vec3();
+        }
         let r = Vec3::splat(b.shape.bounding_radius());
         lo = lo.min(p - r);
         hi = hi.max(p + r);

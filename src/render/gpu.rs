@@ -17,8 +17,13 @@ pub(crate) const RENDER: &str = include_str!("../../shaders/render.wgsl");
 /// The WGSL of every render pipeline: the shared constants, common.wgsl (the
 /// body's pose and the quaternion helpers; it binds nothing), render.wgsl.
 pub fn shader_source() -> String {
-    crate::gpu::shaders::shared_constants() + crate::gpu::shaders::COMMON + RENDER
+    let own = format!("// The renderer's own, from src/render/gpu.rs.\nconst HULL_MESH: u32 = {HULL_MESH}u;\n");
+    crate::gpu::shaders::shared_constants() + &own + crate::gpu::shaders::COMMON + RENDER
 }
+
+/// `RenderBody::shape` of a hull, past the step's `SHAPE_*`: drawn from
+/// its own mesh, unscaled and plainly coloured.
+pub(crate) const HULL_MESH: u32 = 3;
 
 /// Samples per pixel: 4x MSAA, which WebGPU guarantees for both formats below.
 pub(crate) const SAMPLES: u32 = 4;
@@ -59,13 +64,13 @@ pub struct Globals {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RenderBody {
     /// Box: half extents (m); sphere: the radius three times; capsule:
-    /// (radius, half height, radius).
+    /// (radius, half height, radius); hull: 1 three times (its mesh is in metres).
     pub half_extents: [f32; 3],
     /// Index of the body in the state buffer.
     pub body: u32,
     /// Linear RGB.
     pub color: [f32; 3],
-    /// `SHAPE_BOX`, `SHAPE_SPHERE` or `SHAPE_CAPSULE`.
+    /// `SHAPE_BOX`, `SHAPE_SPHERE`, `SHAPE_CAPSULE` or `HULL_MESH`.
     pub shape: u32,
 }
 
@@ -243,10 +248,10 @@ impl RenderPipelines {
 /// The renderer's buffers and textures, all made once at start-up.
 pub(crate) struct RenderData {
     pub globals: wgpu::Buffer,
-    /// `RenderBody` per body, boxes first, then spheres and capsules.
+    /// `RenderBody` per body, boxes first, then spheres and capsules, then hulls.
     pub bodies: wgpu::Buffer,
     pub joints: wgpu::Buffer,
-    /// The unit cube (36 vertices), then the unit icosphere.
+    /// The unit cube (36 vertices), then the unit icosphere, then the hulls' meshes.
     pub mesh: wgpu::Buffer,
     /// Bound instead of a world's state buffer when the world has no bodies
     /// (a binding must hold at least one element).
@@ -277,6 +282,8 @@ pub(super) struct Canvas {
     box_count: u32,
     round_count: u32,
     sphere_vertices: u32,
+    /// Per hull shape: its vertices in `RenderData::mesh`, and its slots.
+    hull_runs: Vec<(std::ops::Range<u32>, std::ops::Range<u32>)>,
     joint_count: u32,
     /// Bind groups by the state buffer they bind (a world alternates two).
     bind_groups: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
@@ -306,6 +313,13 @@ impl Canvas {
         let cube_vertices = mesh.len();
         mesh.extend(icosphere(ICOSPHERE_LEVEL));
         let sphere_vertices = (mesh.len() - cube_vertices) as u32;
+        let hulls_start = mesh.len() as u32;
+        mesh.extend_from_slice(&instances.hull_mesh);
+        let hull_runs = instances
+            .hull_runs
+            .iter()
+            .map(|r| (hulls_start + r.vertices.start..hulls_start + r.vertices.end, r.slots.clone()))
+            .collect();
 
         let buffer = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
             let buf = device.create_buffer(&wgpu::BufferDescriptor {
@@ -394,6 +408,7 @@ impl Canvas {
             box_count: instances.box_count,
             round_count: instances.round_count,
             sphere_vertices,
+            hull_runs,
             joint_count: joints.len() as u32,
             bind_groups: Vec::new(),
         }
@@ -518,13 +533,17 @@ impl Canvas {
         RgbaImage::from_raw(self.width, self.height, pixels).ok_or_else(|| gpu_err("render: readback has the wrong size".into()))
     }
 
-    /// One instanced draw per mesh: the boxes' slots, then the spheres' and capsules'.
+    /// One instanced draw per mesh: the boxes' slots, then the spheres' and
+    /// capsules', then each hull shape's.
     fn draw_bodies(&self, pass: &mut wgpu::RenderPass) {
         if self.box_count > 0 {
             pass.draw(0..36, 0..self.box_count);
         }
         if self.round_count > 0 {
             pass.draw(36..36 + self.sphere_vertices, self.box_count..self.box_count + self.round_count);
+        }
+        for (vertices, slots) in &self.hull_runs {
+            pass.draw(vertices.clone(), slots.clone());
         }
     }
 

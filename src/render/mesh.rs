@@ -1,14 +1,17 @@
-//! The unit meshes every body is drawn from, scaled per instance: a cube
-//! and an icosphere, wound for back-face culling.
+//! The meshes bodies are drawn from, wound for back-face culling: a unit
+//! cube and a unit icosphere, scaled per instance, and each hull's own
+//! faceted mesh, in metres.
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{DQuat, DVec3, Vec3};
+
+use crate::scene::hull::Hull;
 
 /// Subdivisions of the icosahedron for spheres: 1280 triangles, smooth at
 /// any size a sphere takes in a frame.
 pub(super) const ICOSPHERE_LEVEL: u32 = 3;
 
-/// A vertex of the unit meshes (24 bytes): position and outward normal.
+/// A vertex of the meshes (24 bytes): position and outward normal.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub(super) struct MeshVertex {
@@ -99,4 +102,61 @@ pub(super) fn icosphere(level: u32) -> Vec<MeshVertex> {
         .flat_map(|[a, b, c]| outward(a, b, c, a + b + c))
         .map(|q| MeshVertex { pos: q.to_array(), normal: q.to_array() })
         .collect()
+}
+
+/// `hull`'s faces, each fanned into triangles with its own normal (flat
+/// shading), in the frame the body's pose is kept in: `frame` is
+/// `Body::mass_frame` (its centre and axes in the hull's frame), so a
+/// point p is drawn at axes^-1 (p - centre).
+pub(super) fn hull_mesh(hull: &Hull, frame: Option<(DVec3, DQuat)>) -> Vec<MeshVertex> {
+    let (centre, axes) = frame.unwrap_or((DVec3::ZERO, DQuat::IDENTITY));
+    let to_kept = |p: DVec3| (axes.conjugate() * (p - centre)).as_vec3();
+    let mut v = Vec::new();
+    for face in &hull.faces {
+        let n = (axes.conjugate() * face.normal).as_vec3();
+        let corner = |k: usize| to_kept(hull.vertices[face.corners[k]]);
+        for k in 1..face.corners.len().saturating_sub(1) {
+            for p in outward(corner(0), corner(k), corner(k + 1), n) {
+                v.push(MeshVertex { pos: p.to_array(), normal: n.to_array() });
+            }
+        }
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Body, HullShape, Shape};
+
+    /// A box hull off its frame's origin: two triangles a face, each wound
+    /// outward with its face's normal, its corners moved into the kept
+    /// frame, where they sit about the centre of mass.
+    #[test]
+    fn a_hull_mesh_is_its_faces_fanned_in_the_kept_frame() {
+        let points: Vec<[f32; 3]> =
+            (0..8).map(|k| [2.0 + (k & 1) as f32, 1.0 + 0.5 * ((k >> 1) & 1) as f32, 0.25 * ((k >> 2) & 1) as f32]).collect();
+        let body = Body::new(Shape::Hull(HullShape::new(points).unwrap()), [0.0; 3]);
+        let Shape::Hull(shape) = &body.shape else { unreachable!() };
+        let frame = body.mass_frame().unwrap();
+        let mesh = hull_mesh(shape.hull(), Some(frame));
+        assert_eq!(mesh.len(), 6 * 2 * 3);
+        for tri in mesh.chunks(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| Vec3::from_array(tri[k].pos));
+            let n = Vec3::from_array(tri[0].normal);
+            assert!((b - a).cross(c - a).normalize().dot(n) > 0.999, "{tri:?}");
+            assert!(tri.iter().all(|v| v.normal == tri[0].normal));
+        }
+        // each vertex is a corner moved by p' = axes^-1 (p - centre)
+        let (centre, axes) = frame;
+        for v in &mesh {
+            let p = axes * Vec3::from_array(v.pos).as_dvec3() + centre;
+            assert!(shape.hull().vertices.iter().any(|c| (*c - p).length() < 1e-5), "{v:?}");
+        }
+        let mean = mesh.iter().map(|v| Vec3::from_array(v.pos)).sum::<Vec3>() / mesh.len() as f32;
+        assert!(mean.length() < 1e-5, "{mean}");
+        // in its own frame (a kinematic hull's), the corners as given
+        let own = hull_mesh(shape.hull(), None);
+        assert!(own.iter().all(|v| v.pos[0] >= 2.0 && v.pos[1] >= 1.0));
+    }
 }

@@ -4,7 +4,8 @@
 //! The bodies are drawn straight from the world's current state buffer, bound
 //! read-only in the vertex shader (`shaders/render.wgsl`): nothing is read
 //! back to draw, only the finished image is. What never changes (each body's
-//! shape, size and colour) is uploaded once from the [`Scene`].
+//! shape, size and colour, each hull shape's mesh) is uploaded once from the
+//! [`Scene`].
 //!
 //! ```no_run
 //! use std::path::Path;
@@ -21,7 +22,7 @@
 //! The parts: `gpu.rs` is the GPU plumbing (the WGSL and the records it
 //! reads, the pipelines, buffers and textures, a frame's passes and the
 //! readback); `camera.rs` the maths of where a frame is seen from and lit;
-//! `bodies.rs` what each body looks like; `mesh.rs` the unit meshes;
+//! `bodies.rs` what each body looks like; `mesh.rs` the meshes;
 //! `files.rs` images to files. As the step splits pipelines from buffers,
 //! `RenderPipelines` holds only what is compiled (built once, in
 //! [`Renderer::new`]) and `RenderData` only buffers and textures; a frame

@@ -313,6 +313,77 @@ fn a_capsule_renders_as_a_capsule() {
     }
 }
 
+/// Pure blue, shaded: blue well above red and green.
+fn is_blue(p: &Rgba<u8>) -> bool {
+    p[2] > 40 && p[2] as u32 > 2 * p[0] as u32 + 10 && p[2] as u32 > 2 * p[1] as u32 + 10
+}
+
+/// Hulls are drawn as their faces, where their points are: a prism over a
+/// scalene triangle, seen end on, turned about the view axis, its points
+/// well off its frame's origin. One is fixed (its pose kept at its centre
+/// of mass on its principal axes, `Body::mass_frame`), one kinematic (its
+/// pose kept in its own frame): each covers its own triangle and not the
+/// disc of its bounding sphere.
+#[test]
+fn hulls_render_as_their_faces_where_their_points_are() {
+    use glam::{Quat, Vec2, Vec3};
+    let triangle = [Vec2::new(0.0, 0.0), Vec2::new(2.0, 0.0), Vec2::new(0.4, 1.5)];
+    let (offset, depth) = (Vec2::new(1.5, -0.4), 0.3f32);
+    let points: Vec<[f32; 3]> = [-depth, depth].iter().flat_map(|&z| triangle.map(|t| (t + offset).extend(z).to_array())).collect();
+    let shape = verlet::scene::HullShape::new(points).unwrap();
+    let hull = |position: [f32; 3], turn: f32, kinematic: bool| {
+        let mut b = verlet::Body::new(verlet::Shape::Hull(shape.clone()), position);
+        b.orientation = Quat::from_rotation_z(turn).to_array();
+        (b.fixed, b.kinematic) = (!kinematic, kinematic);
+        b
+    };
+    let mut scene = scenes::drop();
+    scene.bodies = vec![hull([-4.0, 0.5, 0.0], 0.35, false), hull([0.2, 1.7, 0.0], -0.25, true)];
+    assert!(scene.bodies[0].mass_frame().is_some() && scene.bodies[1].mass_frame().is_none());
+    scene.camera = Some(Camera { position: [0.0, 1.0, 12.0], target: [0.0, 1.0, 0.0], fov_y: 30f32.to_radians() });
+    let Some(world) = crate::common::world(&scene) else { return };
+    let mut renderer = Renderer::new(world.gpu(), &scene, WIDTH, HEIGHT).unwrap();
+    renderer.set_body_color(0, [1.0, 0.0, 0.0]).unwrap();
+    renderer.set_body_color(1, [0.0, 0.0, 1.0]).unwrap();
+    let img = renderer.render(&world).unwrap();
+
+    let colours: [fn(&Rgba<u8>) -> bool; 2] = [is_red, is_blue];
+    for (k, (body, is_colour)) in scene.bodies.iter().zip(colours).enumerate() {
+        // a point of the body's frame in the world, and in the image
+        let world_point = |p: Vec3| Vec3::from_array(body.position) + Quat::from_array(body.orientation) * p;
+        let pixel = |p: Vec3| renderer.project(world_point(p).to_array()).expect("the hull is in view");
+        let coloured = |p: Vec3| {
+            let q = pixel(p);
+            is_colour(img.get_pixel(q[0] as u32, q[1] as u32))
+        };
+        // on the face towards the camera
+        let front = |t: Vec2| (t + offset).extend(depth);
+        let g = (triangle[0] + triangle[1] + triangle[2]) / 3.0;
+        for t in triangle {
+            assert!(coloured(front(g + 0.8 * (t - g))), "body {k}: not drawn towards corner {t}");
+        }
+        assert!(coloured(front(g)), "body {k}: not drawn at its middle");
+        // beyond each edge by a fifth of its height or more, inside the bounding sphere
+        let radius = body.bounding_radius();
+        let centre = shape.hull().centroid.as_vec3();
+        for e in 0..3 {
+            let mid = 0.5 * (triangle[e] + triangle[(e + 1) % 3]);
+            let t = g + 1.6 * (mid - g);
+            assert!((front(t) - centre).length() < 0.9 * radius);
+            assert!(!coloured(front(t)), "body {k}: drawn beyond edge {e}, inside its bounding sphere");
+        }
+        // the pixels it covers: about its triangle's, far fewer than its bounding sphere's
+        let corners = triangle.map(|t| Vec2::from_array(pixel(front(t))));
+        let triangle_px = 0.5 * (corners[1] - corners[0]).perp_dot(corners[2] - corners[0]).abs();
+        let disc_px = std::f32::consts::PI
+            * (Vec2::from_array(pixel(centre)) - Vec2::from_array(pixel(centre + radius * Vec3::X))).length_squared();
+        let (_, n) = centroid(&img, is_colour);
+        eprintln!("body {k}: {n} pixels, its front triangle {triangle_px:.0}, its bounding sphere's disc {disc_px:.0}");
+        assert!((0.9..1.2).contains(&(n as f32 / triangle_px)), "body {k}: {n} pixels for a triangle of {triangle_px:.0}");
+        assert!((n as f32) < 0.4 * disc_px, "body {k}: {n} pixels, near its bounding sphere's {disc_px:.0}");
+    }
+}
+
 #[test]
 fn the_render_shader_validates_with_naga() {
     let module = verlet::gpu::shaders::validate(&render::shader_source()).unwrap_or_else(|e| panic!("render.wgsl:\n{e}"));
