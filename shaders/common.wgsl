@@ -196,8 +196,8 @@ fn contact_ref(manifold: u32, is_b: bool) -> u32 {
 // MAX_DEPENETRATION_SPEED (shared with Rust): the fastest (m/s) the solve
 // pushes apart bodies that already overlapped at their previous poses.
 
-// Points closer than this (m) still touch when restitution is decided after the solve.
-const CONTACT_SLOP: f32 = 0.002;
+// CONTACT_SLOP (shared with Rust): points closer than this (m) still touch
+// when restitution is decided after the solve.
 // One end of a ball joint as the body at that end sees it: both anchors, each in its
 // body's frame (the world's in world coordinates). 32 bytes.
 struct JointRef {

@@ -140,19 +140,33 @@ fn nearest_on_face(h: Poly, f: u32, n: vec3<f32>, x: vec3<f32>) -> vec3<f32> {
 }
 
 // The up-to-four points `reduce` keeps of `count` candidates (points and
-// their heights above a plane of normal n): the deepest, the farthest from
-// it, the largest triangle, the largest area added on the other side; as
-// src/reference/collide.rs's reduce, the first of equals each time. Their
-// indices, distinct, in the order chosen, and how many.
+// their heights above a plane of normal n): the deepest, or on the ground
+// (`level`) the farthest from `about` of those within CONTACT_SLOP of the
+// deepest (a hull on a face has more than four corners there, and which is
+// deepest changes as it settles: a choice by depth alone rocked it); the
+// farthest from that; the largest triangle; the largest area added on the
+// other side. As src/reference/collide.rs's reduce, the first of equals each
+// time. Their indices, distinct, in the order chosen, and how many.
 struct Chosen {
     at: vec4<u32>,
     count: u32,
 }
 
-fn reduce(p: ptr<function, array<vec3<f32>, MAX_CLIP>>, height: ptr<function, array<f32, MAX_CLIP>>, count: u32, n: vec3<f32>) -> Chosen {
+fn reduce(p: ptr<function, array<vec3<f32>, MAX_CLIP>>, height: ptr<function, array<f32, MAX_CLIP>>, count: u32, n: vec3<f32>,
+          about: vec3<f32>, level: bool) -> Chosen {
     var c0 = 0u;
     for (var i = 0u; i < count; i = i + 1u) {
         if ((*height)[i] < (*height)[c0]) {
+            c0 = i;
+        }
+    }
+    let deepest = (*height)[c0];
+    var far = -1.0;
+    for (var i = 0u; i < count; i = i + 1u) {
+        let off = (*p)[i] - about;
+        let d = dot(off, off) - dot(off, n) * dot(off, n);
+        if (level && (*height)[i] <= deepest + CONTACT_SLOP && d > far) {
+            far = d;
             c0 = i;
         }
     }
@@ -269,7 +283,7 @@ fn face_contact(reference: Poly, face: u32, incident: Poly, rel: Relative, margi
     if (near == 0u) {
         return m;
     }
-    let chosen = reduce(&kept, &heights, near, n);
+    let chosen = reduce(&kept, &heights, near, n, vec3<f32>(0.0), false);
     for (var q = 0u; q < chosen.count; q = q + 1u) {
         let x = kept[chosen.at[q]];
         m.on_a[q] = x - n * heights[chosen.at[q]];
@@ -619,7 +633,7 @@ fn ground_hull(a: Solid, ground: f32, margin: f32) -> Manifold {
     if (near == 0u) {
         return m;
     }
-    let chosen = reduce(&corners, &heights, near, vec3<f32>(0.0, 1.0, 0.0));
+    let chosen = reduce(&corners, &heights, near, vec3<f32>(0.0, 1.0, 0.0), a.pos, true);
     for (var q = 0u; q < chosen.count; q = q + 1u) {
         let w = corners[chosen.at[q]];
         m.on_a[q] = w;

@@ -71,6 +71,11 @@ pub const MAX_DEPENETRATION_SPEED: f32 = 3.0;
 /// step comes on top of it (pairs.wgsl's `pair_margin`).
 pub const CONTACT_MARGIN: f32 = 0.01;
 
+/// Points closer than this (m) still touch when restitution is decided
+/// after the solve; a hull's contact points this near the deepest count as
+/// deep as it (`reduce`).
+pub const CONTACT_SLOP: f32 = 0.002;
+
 /// What was wrong with a faulted body: the low three bits of `Status::fault`
 /// (`FAULT_*` in the shaders).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

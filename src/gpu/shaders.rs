@@ -20,7 +20,7 @@ pub fn shared_constants() -> String {
     use crate::gpu::status::{Status, DISPATCH_Y, DISPATCH_Z};
     use crate::gpu::types::*;
     use crate::limits::{
-        FaultKind, CONTACT_MARGIN, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT,
+        FaultKind, CONTACT_MARGIN, CONTACT_SLOP, MAX_DEPENETRATION_SPEED, MAX_DISTANCE, MAX_SPEED, MAX_SPIN, MAX_TURN, NO_FAULT,
     };
     let mut out = String::from("// Shared with Rust: written by src/gpu/shaders.rs from the Rust constants.\n");
     let words = [
@@ -65,6 +65,7 @@ pub fn shared_constants() -> String {
         ("MAX_TURN", MAX_TURN),
         ("MAX_DEPENETRATION_SPEED", MAX_DEPENETRATION_SPEED),
         ("CONTACT_MARGIN", CONTACT_MARGIN),
+        ("CONTACT_SLOP", CONTACT_SLOP),
     ] {
         out += &wgsl_f32(name, value);
     }

@@ -305,7 +305,7 @@ pub fn box_box(ca: Vec3, qa: Quat, ha: Vec3, cb: Vec3, qb: Quat, hb: Vec3, margi
     if points.is_empty() {
         return None;
     }
-    let points = reduce(points)
+    let points = reduce(points, None)
         .into_iter()
         .map(|(p, z)| {
             let on_ref = ref_centre + su * p.x + sv * p.y;
@@ -379,12 +379,28 @@ pub(crate) fn closest_on_edges(pa: Vec3, da: Vec3, la: f32, pb: Vec3, db: Vec3, 
 /// above it) that keep the deepest one and span the most area. Run on every
 /// face contact, as on the GPU: four or fewer points in general position
 /// all stay, a point that adds no area (between two others on a line) goes.
-pub(crate) fn reduce(points: Vec<(Vec2, f32)>) -> Vec<(Vec2, f32)> {
+/// With `about` (a hull's centre, on the ground), the first is the one
+/// farthest from it of those within `CONTACT_SLOP` of the deepest: a hull
+/// resting on a face has more than four corners on the ground, and the
+/// deepest of them changes as it settles by less than a millimetre; a choice
+/// by depth alone rocked it.
+pub(crate) fn reduce(points: Vec<(Vec2, f32)>, about: Option<Vec2>) -> Vec<(Vec2, f32)> {
     // 1: deepest (the first of equals, as every choice here)
     let mut chosen = [0usize; 4];
     for (i, p) in points.iter().enumerate() {
         if p.1 < points[chosen[0]].1 {
             chosen[0] = i;
+        }
+    }
+    if let Some(c) = about {
+        let deepest = points[chosen[0]].1;
+        let mut best = -1.0;
+        for (i, p) in points.iter().enumerate() {
+            let d = (p.0 - c).length_squared();
+            if p.1 <= deepest + crate::limits::CONTACT_SLOP && d > best {
+                best = d;
+                chosen[0] = i;
+            }
         }
     }
     // 2: farthest from it

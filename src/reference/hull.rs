@@ -272,7 +272,7 @@ fn face_contact(reference: &Polytope, face: usize, incident: &Polytope, margin: 
     if candidates.is_empty() {
         return Vec::new();
     }
-    reduce(candidates)
+    reduce(candidates, None)
         .into_iter()
         .map(|(at, height)| {
             let on_ref = u * at.x + v * at.y + *n * *d;
@@ -457,7 +457,7 @@ pub fn ground_hull(p: &Polytope, ground: f32, margin: f32) -> Option<Manifold> {
         return None;
     }
     let candidates = near.iter().map(|w| (Vec2::new(w.z, w.x), w.y - ground)).collect();
-    let points = reduce(candidates)
+    let points = reduce(candidates, Some(Vec2::new(p.centre.z, p.centre.x)))
         .into_iter()
         .map(|(at, height)| {
             let on_b = Vec3::new(at.y, ground, at.x);

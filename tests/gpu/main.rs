@@ -21,6 +21,7 @@ mod narrowphase_parity;
 mod physics_capsules;
 mod physics_contacts;
 mod physics_core;
+mod physics_hulls;
 mod physics_joints;
 mod physics_kinematic;
 mod render;
