@@ -17,9 +17,10 @@ pub const SEED: u64 = 1;
 /// default). `cubes-1m` runs at the adapter's maximum when 1M does not fit.
 /// `pile-*` are cubes dropped in four layers that land on each other and
 /// heap up three and four deep (`verlet scene pile`); `capsules-*` the same
-/// with capsules of random sizes (`verlet scene capsules`). `large_pyramid`,
-/// `many_pyramids` and `joint_grid` are Box3D's benchmarks of those names
-/// at Box3D's sizes.
+/// with capsules of random sizes (`verlet scene capsules`), `hulls-*` with
+/// convex rocks (`verlet scene convex_pile`). `large_pyramid`,
+/// `many_pyramids`, `joint_grid` and `washer` (8000 cubes in a drum of
+/// kinematic hulls) are Box3D's benchmarks of those names at Box3D's sizes.
 pub const CASES: &[(&str, &str, Option<usize>)] = &[
     ("cubes-1k", "cubes", Some(1_000)),
     ("cubes-10k", "cubes", Some(10_000)),
@@ -31,11 +32,14 @@ pub const CASES: &[(&str, &str, Option<usize>)] = &[
     ("pile-1m", "pile", Some(1_000_000)),
     ("capsules-1k", "capsules", Some(1_000)),
     ("capsules-10k", "capsules", Some(10_000)),
+    ("hulls-1k", "convex_pile", Some(1_000)),
+    ("hulls-10k", "convex_pile", Some(10_000)),
     ("pyramid", "pyramid", Some(20)),
     ("chain", "chain", Some(21)),
     ("large_pyramid", "large_pyramid", Some(100)),
     ("many_pyramids", "many_pyramids", Some(14)),
     ("joint_grid", "joint_grid", Some(100)),
+    ("washer", "washer", Some(20)),
 ];
 
 /// The cases `--quick` runs.
@@ -246,6 +250,8 @@ mod tests {
         }
         assert_eq!(case("many_pyramids").scene().bodies.len(), 10_780);
         assert_eq!(case("joint_grid").scene().joints.len(), 19_800);
+        assert_eq!(case("washer").scene().bodies.len(), 8042);
+        assert_eq!(case("hulls-1k").scene().bodies.len(), 1000);
         let c = Case::parse("cubes:2000").unwrap();
         assert_eq!((c.name.as_str(), c.count), ("cubes-2000", Some(2000)));
         assert!(Case::parse("nope").is_err());

@@ -2,7 +2,7 @@
 //! up, so that a bench case here and there names the same world.
 
 use super::build::{box_body, scene, sphere_body};
-use crate::scene::{Body, Joint, Scene};
+use crate::scene::{Body, HullShape, Joint, Scene, Shape};
 
 /// Box3D's benchmark world, as its `benchmark` program sets it up: gravity
 /// 10 m/s^2 (ours is 9.81), friction 0.6 and restitution 0 (its default
@@ -101,6 +101,130 @@ pub fn joint_grid(side: usize) -> Scene {
     let mut s = box3d_world(bodies, joints);
     s.ground = None;
     s
+}
+
+/// The drum of [`washer`]: where it is, how large, how fast it turns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drum {
+    /// The middle of its axis, which runs along z (m); every panel's and
+    /// baffle's `position`, the point its frame turns about.
+    pub centre: [f32; 3],
+    /// The panels' inner radius (m): the drum's room is within it and
+    /// between the end walls.
+    pub inner_radius: f32,
+    /// The panels' outer radius (m).
+    pub outer_radius: f32,
+    /// How far in the baffles reach from the axis (m).
+    pub baffle_radius: f32,
+    /// Half its length (m): the end walls' inner faces are at `centre` z
+    /// plus and minus this, where the panels end.
+    pub half_length: f32,
+    /// Its turn about +z (rad/s), every panel's and baffle's.
+    pub spin: f32,
+}
+
+/// The panels around a `washer`'s drum (Box3D's), each spanning 10 degrees.
+pub(crate) const WASHER_PANELS: usize = 36;
+/// The baffles: one on every ninth panel.
+pub(crate) const WASHER_BAFFLES: usize = WASHER_PANELS / 9;
+/// The drum's bodies: its panels, its baffles and its two end walls.
+pub(crate) const WASHER_DRUM_BODIES: usize = WASHER_PANELS + WASHER_BAFFLES + 2;
+/// A `washer` cube's half extent and the lattice's pitch (m), Box3D's.
+const WASHER_CUBE: f32 = 0.2;
+const WASHER_PITCH: f32 = 4.0 * WASHER_CUBE;
+
+/// The drum of `washer` for `side` x `side` x `side` cubes: Box3D's (axis
+/// 21 m up, panels from 16 to 18 m out, baffles to 14 m in, 20 m long,
+/// turning at 25 degrees a second) while it holds the cubes' lattice with
+/// 0.5 m to spare (up to 24 a side), else Box3D's scaled by as much as it
+/// takes, turning slower by the square root of the scale so that it lifts
+/// and drops the cubes as Box3D's does (the same omega^2 r / g).
+pub fn washer_drum(side: usize) -> Drum {
+    // the lattice's half width, from the axis to its cubes' far faces
+    let half = WASHER_PITCH * side.saturating_sub(1) as f32 / 2.0 + WASHER_CUBE;
+    let room = 0.5;
+    let scale = 1f32.max((half * std::f32::consts::SQRT_2 + room) / 14.0).max((half + room) / 10.0);
+    Drum {
+        centre: [0.0, 21.0 * scale, 0.0],
+        inner_radius: 16.0 * scale,
+        outer_radius: 18.0 * scale,
+        baffle_radius: 14.0 * scale,
+        half_length: 10.0 * scale,
+        spin: 25f32.to_radians() / scale.sqrt(),
+    }
+}
+
+/// `washer`: Box3D's benchmark of that name, `side` x `side` x `side`
+/// cubes of 0.4 m (Box3D: 20 x 20 x 20 = 8000; 1000 kg/m^3, Box3D's
+/// water) tumbled in a drum turning about a horizontal axis ([`washer_drum`]).
+/// Box3D's drum is one kinematic body of 40 hulls; here each is a body of
+/// its own, a kinematic hull whose `position` is the drum's axis (a
+/// kinematic body turns about its frame's origin), all with the drum's
+/// spin:
+///
+/// - 36 panels, each the hull of 8 points: the annular sector from the
+///   inner to the outer radius over its 10 degrees widened by 1 degree on
+///   either side (as Box3D's), so that neighbours overlap and no gap opens
+///   between them;
+/// - on every ninth panel a baffle, the sector of its 10 degrees from the
+///   baffle radius out to the inner radius, which lifts the cubes.
+///
+/// Box3D's drum is open at its ends; here two fixed boxes 1 m thick close
+/// them, their inner faces where the panels end, and as wide and tall as the
+/// drum. Box3D's lattice (0.8 m pitch) starts in the drum's lower half,
+/// its lowest cubes inside the panels; here it is as low as it fits within
+/// the baffles' reach with 0.5 m to spare, centred on the axis along x and
+/// z (at Box3D's size its lowest cubes start 5 m above the panels). On the
+/// ground, as Box3D's; Box3D's world (`box3d_world`).
+pub fn washer(side: usize) -> Scene {
+    let drum = washer_drum(side);
+    let (r0, r1, r2, h) = (drum.baffle_radius, drum.inner_radius, drum.outer_radius, drum.half_length);
+    let step = std::f32::consts::TAU / WASHER_PANELS as f32;
+    let widen = 0.1 * step;
+    // the hull of the sector from radius `inner` to `outer` between two
+    // angles, the drum's length long, in the drum's frame
+    let sector = |inner: f32, outer: f32, from: f32, to: f32| {
+        let mut points = Vec::with_capacity(8);
+        for z in [-h, h] {
+            for r in [inner, outer] {
+                for a in [from, to] {
+                    points.push([r * a.cos(), r * a.sin(), z]);
+                }
+            }
+        }
+        let shape = HullShape::new(points).expect("a sector of a ring spans a volume");
+        Body { angular_velocity: [0.0, 0.0, drum.spin], kinematic: true, ..Body::new(Shape::Hull(shape), drum.centre) }
+    };
+    let mut bodies = Vec::with_capacity(WASHER_DRUM_BODIES + side.saturating_mul(side).saturating_mul(side));
+    for i in 0..WASHER_PANELS {
+        let a = i as f32 * step;
+        bodies.push(sector(r1, r2, a - widen, a + step + widen));
+    }
+    for i in (0..WASHER_PANELS).step_by(WASHER_PANELS / WASHER_BAFFLES) {
+        let a = i as f32 * step;
+        bodies.push(sector(r0, r1, a, a + step));
+    }
+    let [x, y, z] = drum.centre;
+    for end in [-1.0f32, 1.0] {
+        let mut wall = box_body([r2, r2, 0.5], [x, y, z + end * (h + 0.5)]);
+        wall.fixed = true;
+        bodies.push(wall);
+    }
+    // the lattice centred on the axis along x and z, and as low as its
+    // lowest edges stay within the baffles' reach with 0.5 m to spare
+    // (`washer_drum` leaves room), so that the cubes fall no farther than
+    // they must
+    let half = WASHER_PITCH * side.saturating_sub(1) as f32 / 2.0 + WASHER_CUBE;
+    let low = half - ((r0 - 0.5).powi(2) - half * half).max(0.0).sqrt();
+    let at = |k: usize| WASHER_PITCH * k as f32 - half + WASHER_CUBE;
+    for i in 0..side {
+        for j in 0..side {
+            for k in 0..side {
+                bodies.push(box_body([WASHER_CUBE; 3], [x + at(i), y + low + at(j), z + at(k)]));
+            }
+        }
+    }
+    box3d_world(bodies, vec![])
 }
 
 #[cfg(test)]
@@ -235,6 +359,114 @@ mod tests {
                 assert_eq!(b.shape, Shape::Sphere { radius: 0.4 });
             }
             s.validate().unwrap();
+        }
+    }
+
+    /// The angle of `p` about the z axis, in [0, 2 pi).
+    fn angle(p: glam::Vec3) -> f32 {
+        p.y.atan2(p.x).rem_euclid(std::f32::consts::TAU)
+    }
+
+    /// Asserts that `s` is a washer of `side` cubes a side in `drum`: its
+    /// drum's bodies first, then the cubes; the panels and baffles
+    /// kinematic hulls at the axis with the drum's spin, the panels closing
+    /// the ring (each overlapping the next), the baffles within it, the end
+    /// walls fixed boxes covering the ends where the panels stop, and every
+    /// cube inside the baffles' reach and between the walls, none touching
+    /// another.
+    fn assert_washer(s: &Scene, side: usize, drum: &Drum) {
+        let centre = glam::Vec3::from(drum.centre);
+        assert_eq!(s.bodies.len(), WASHER_DRUM_BODIES + side * side * side);
+        let (hulls, rest) = s.bodies.split_at(WASHER_PANELS + WASHER_BAFFLES);
+        let mut spans = Vec::new();
+        for (n, b) in hulls.iter().enumerate() {
+            let Shape::Hull(shape) = &b.shape else { panic!("body {n} is not a hull: {:?}", b.shape) };
+            assert!(b.kinematic && !b.fixed && b.mass_frame().is_none(), "body {n}");
+            assert_eq!((b.position, b.orientation), (drum.centre, [0.0, 0.0, 0.0, 1.0]), "body {n} turns about the axis");
+            assert_eq!((b.angular_velocity, b.linear_velocity), ([0.0, 0.0, drum.spin], [0.0; 3]), "body {n}");
+            let points: Vec<glam::Vec3> = shape.points().iter().map(|&p| glam::Vec3::from(p)).collect();
+            assert_eq!((points.len(), shape.hull().vertices.len()), (8, 8), "body {n}: a sector of 8 corners");
+            let (inner, outer) =
+                if n < WASHER_PANELS { (drum.inner_radius, drum.outer_radius) } else { (drum.baffle_radius, drum.inner_radius) };
+            for p in &points {
+                let r = p.truncate().length();
+                assert!((r - inner).abs() < 1e-3 * inner || (r - outer).abs() < 1e-3 * outer, "body {n}: a corner {r} m out");
+                assert!((p.z.abs() - drum.half_length).abs() < 1e-5, "body {n}: a corner at z = {}", p.z);
+            }
+            // its angles about its first corner's, within half a turn (a
+            // panel crosses 0): where it starts and how wide it is
+            let pi = std::f32::consts::PI;
+            let first = angle(points[0]);
+            let about = points.iter().map(|&p| (angle(p) - first + pi).rem_euclid(std::f32::consts::TAU) - pi);
+            let (lo, hi) = about.fold((f32::MAX, f32::MIN), |(lo, hi), d| (lo.min(d), hi.max(d)));
+            spans.push((n, first + lo, hi - lo));
+        }
+        let step = std::f32::consts::TAU / WASHER_PANELS as f32;
+        for &(n, start, width) in &spans[..WASHER_PANELS] {
+            assert!((width - 1.2 * step).abs() < 1e-4, "panel {n} spans {width} rad");
+            // the next panel starts before this one ends: no gap between them
+            let next = spans[(n + 1) % WASHER_PANELS].1;
+            let overlap = (start + width - next).rem_euclid(std::f32::consts::TAU);
+            assert!((overlap - 0.2 * step).abs() < 1e-4, "panels {n} and the next overlap by {overlap} rad");
+        }
+        for &(n, _, width) in &spans[WASHER_PANELS..] {
+            assert!((width - step).abs() < 1e-4, "baffle {n} spans {width} rad");
+        }
+        let (walls, cubes) = rest.split_at(2);
+        for (end, w) in [-1.0f32, 1.0].into_iter().zip(walls) {
+            let Shape::Box { half_extents: h } = w.shape else { panic!("an end wall is not a box") };
+            assert!(w.fixed && !w.kinematic);
+            assert!(h[0] >= drum.outer_radius && h[1] >= drum.outer_radius, "an end wall of half extents {h:?}");
+            let inner_face = (w.position[2] - h[2] * end - centre.z) * end;
+            assert!((inner_face - drum.half_length).abs() < 1e-5, "an end wall's inner face {inner_face} m along the axis");
+            assert_eq!((w.position[0], w.position[1]), (centre.x, centre.y));
+            assert!(w.position[1] - h[1] > 0.0, "an end wall stands on nothing: it is above the ground");
+        }
+        for (n, c) in cubes.iter().enumerate() {
+            assert_eq!(c.shape, Shape::Box { half_extents: [0.2; 3] }, "cube {n}");
+            assert!(c.is_dynamic() && (c.mass - 64.0).abs() < 1e-3, "cube {n}");
+            let p = glam::Vec3::from(c.position) - centre;
+            // its bounding sphere inside the baffles and the walls
+            let reach = c.bounding_radius();
+            assert!(p.truncate().length() + reach < drum.baffle_radius - 0.1, "cube {n} at {p} from the axis's middle");
+            assert!(p.z.abs() + reach < drum.half_length, "cube {n} at {p} from the axis's middle");
+        }
+        // a lattice 0.8 m apart: cubes of 0.4 m do not touch
+        let mut gaps = cubes.windows(2).map(|w| (glam::Vec3::from(w[1].position) - glam::Vec3::from(w[0].position)).length());
+        assert!(gaps.all(|d| d >= 0.8 - 1e-4), "neighbouring cubes nearer than 0.8 m");
+        s.validate().unwrap();
+    }
+
+    #[test]
+    fn washer_is_box3ds_at_its_default_size() {
+        let s = by_name("washer", None, 1).unwrap();
+        assert_eq!(s.bodies.len(), 8042);
+        assert_eq!(body_count("washer", None), Some(8042));
+        assert_eq!(s.ground, Some(Ground { height: 0.0 }));
+        assert_eq!((s.settings.gravity, s.settings.friction, s.settings.sleeping), ([0.0, -10.0, 0.0], 0.6, false));
+        let drum = washer_drum(20);
+        let spin = 25f32.to_radians();
+        assert_eq!(
+            drum,
+            Drum { centre: [0.0, 21.0, 0.0], inner_radius: 16.0, outer_radius: 18.0, baffle_radius: 14.0, half_length: 10.0, spin }
+        );
+        assert_washer(&s, 20, &drum);
+    }
+
+    #[test]
+    fn a_washer_holds_its_cubes_at_any_count() {
+        for side in [0, 1, 2, 5, 24, 25, 40] {
+            let s = washer(side);
+            let drum = washer_drum(side);
+            assert_eq!(body_count("washer", Some(side)), Some(s.bodies.len() as u64));
+            assert_washer(&s, side, &drum);
+            if side <= 24 {
+                assert_eq!(drum, washer_drum(20), "{side} a side fit Box3D's drum");
+            } else {
+                // scaled up, turning slower: omega^2 r as at Box3D's size
+                let scale = drum.inner_radius / 16.0;
+                assert!(scale > 1.0 && (drum.spin * drum.spin * scale - 25f32.to_radians().powi(2)).abs() < 1e-6);
+            }
         }
     }
 }

@@ -9,11 +9,11 @@
 mod box3d;
 mod build;
 
-use box3d::SMALL_PYRAMID_BOXES;
-pub use box3d::{joint_grid, large_pyramid, many_pyramids};
+pub use box3d::{joint_grid, large_pyramid, many_pyramids, washer, washer_drum, Drum};
+use box3d::{SMALL_PYRAMID_BOXES, WASHER_DRUM_BODIES};
 pub use build::{
-    blast, blast_track, box_body, bridge, capsule_ragdoll, capsules, chain, cubes, drop, hanging, pile, pyramid, ragdoll, sphere,
-    sphere_body, stack,
+    blast, blast_track, box_body, bridge, capsule_ragdoll, capsules, chain, convex_pile, cubes, drop, hanging, pile, pyramid,
+    ragdoll, sphere, sphere_body, stack,
 };
 
 use crate::scene::Scene;
@@ -147,6 +147,13 @@ pub const SCENES: &[BuiltIn] = &[
         "{count} ragdolls with capsule limbs and ball heads dropped onto a pile of boxes",
     ),
     BuiltIn::seeded("capsules", capsules, 1000, |n| n, "{count} random capsules dropped in four layers: they heap up ({seed})"),
+    BuiltIn::seeded(
+        "convex_pile",
+        convex_pile,
+        1000,
+        |n| n,
+        "{count} random convex rocks (hulls) dropped in four layers onto each other, after Box3D's benchmark ({seed})",
+    ),
     BuiltIn::counted(
         "blast",
         blast,
@@ -176,6 +183,14 @@ pub const SCENES: &[BuiltIn] = &[
         100,
         |n| n.saturating_mul(n),
         "Box3D's benchmark: {count} x {count} balls (100 x 100) on ball joints, hung by the top row",
+    ),
+    BuiltIn::counted(
+        "washer",
+        washer,
+        20,
+        |n| n.saturating_mul(n).saturating_mul(n).saturating_add(WASHER_DRUM_BODIES as u64),
+        "Box3D's benchmark: {count} x {count} x {count} cubes (20 x 20 x 20) tumbled in a drum of kinematic hull panels, \
+         closed by fixed end walls",
     ),
 ];
 
@@ -354,7 +369,7 @@ mod tests {
     fn the_derived_lists_follow_the_table() {
         let names: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
         assert_eq!(NAMES.to_vec(), names);
-        assert_eq!(RANDOM, ["cubes", "pile", "capsules"]);
+        assert_eq!(RANDOM, ["cubes", "pile", "capsules", "convex_pile"]);
         let mut unique = names.clone();
         unique.sort();
         unique.dedup();

@@ -40,9 +40,10 @@ pub struct BenchArgs {
     /// Cases, comma-separated: cubes-1k, cubes-10k, cubes-100k, cubes-1m
     /// (the adapter's maximum when 1M does not fit), pile-1k, pile-10k,
     /// pile-100k, pile-1m (cubes heaped four deep), capsules-1k, capsules-10k
-    /// (capsules heaped likewise), pyramid, chain,
-    /// large_pyramid, many_pyramids, joint_grid (Box3D's benchmarks at its
-    /// sizes), or SCENE:COUNT. Default: all (with --quick: cubes-1k, cubes-10k, pyramid, chain).
+    /// (capsules heaped likewise), hulls-1k, hulls-10k (convex rocks dropped
+    /// likewise), pyramid, chain, large_pyramid, many_pyramids, joint_grid,
+    /// washer (Box3D's benchmarks at its sizes), or SCENE:COUNT. Default:
+    /// all (with --quick: cubes-1k, cubes-10k, pyramid, chain).
     #[arg(long, value_delimiter = ',')]
     pub cases: Vec<String>,
     /// Steps per repetition (default 300; 60 with --quick).
