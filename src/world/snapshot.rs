@@ -496,7 +496,8 @@ fn hashed_props(p: &BodyProps) -> [u8; 64] {
         p.shape,
         p.flags,
         p.grid_class,
-        p.hull,
+        // what this word held before hulls, for a body that is not one
+        if p.shape == SHAPE_HULL { p.hull } else { 0 },
     ];
     let mut bytes = [0u8; 64];
     for (out, w) in bytes.chunks_exact_mut(4).zip(words) {
