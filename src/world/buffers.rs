@@ -1,6 +1,6 @@
 //! The GPU buffers of a world and the step's bind groups over them.
 
-use std::mem::{offset_of, size_of};
+use std::mem::{offset_of, size_of, size_of_val};
 
 use bytemuck::{Pod, Zeroable};
 
@@ -58,6 +58,15 @@ pub(super) struct WorldData {
     pub batch_start: [wgpu::Buffer; 2],
 }
 
+/// What a scene fixes at start-up, written into `WorldData::statics`: the
+/// bodies kept out of the grid, the hull records and the joint lists.
+#[derive(Clone, Copy)]
+pub(super) struct Statics<'a> {
+    pub large: &'a [u32],
+    pub hulls: &'a [[f32; 4]],
+    pub joints: &'a JointLists,
+}
+
 /// The `dispatch` buffer: each indirect dispatch's size (x, y, z) in a
 /// 16-byte slot of its own.
 #[repr(C)]
@@ -96,11 +105,10 @@ impl WorldData {
         n: usize,
         props: &[BodyProps],
         states: &[BodyState],
-        large: &[u32],
-        hulls: &[[f32; 4]],
-        joints: &JointLists,
+        statics: &Statics,
         substeps: u32,
     ) -> WorldData {
+        let Statics { joints, .. } = *statics;
         let device = &gpu.device;
         let storage = |label: &str, size: u64| storage_buffer(device, label, size);
         let room = n.max(1); // wgpu buffers may not be empty
@@ -133,12 +141,12 @@ impl WorldData {
             dispatch,
             bind_groups: None,
             props: props_buffer(device, n),
-            statics: statics_buffers(device, large, hulls, joints),
+            statics: statics_buffers(device, statics),
             island_rest: island_rest_buffer(device, joints),
             scratch,
             batch_start: [batch_state, storage("batch start/status", Status::BYTES)],
         };
-        data.upload(gpu, props, states, large, hulls, joints);
+        data.upload(gpu, props, states, statics);
         data
     }
 
@@ -150,17 +158,8 @@ impl WorldData {
     /// Params slots where the joint paths' colours need more, the rest (the
     /// contact pools, which follow the need) as they are. Takes the same
     /// handles, so nothing of this world changes until the caller writes.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn refit(
-        &self,
-        gpu: &Gpu,
-        n: usize,
-        room: usize,
-        large: &[u32],
-        hulls: &[[f32; 4]],
-        joints: &JointLists,
-        substeps: u32,
-    ) -> WorldData {
+    pub(super) fn refit(&self, gpu: &Gpu, n: usize, room: usize, statics: &Statics, substeps: u32) -> WorldData {
+        let Statics { joints, .. } = *statics;
         let device = &gpu.device;
         let (states, batch_state, scratch, pair_meta) = if self.body_room() >= n.max(1) {
             (self.states.clone(), self.batch_start[0].clone(), self.scratch.clone(), self.pair_meta.clone())
@@ -186,7 +185,7 @@ impl WorldData {
             dispatch: self.dispatch.clone(),
             bind_groups: None,
             props: props_buffer(device, n),
-            statics: statics_buffers(device, large, hulls, joints),
+            statics: statics_buffers(device, statics),
             island_rest: if self.island_rest.size() >= island_rest_bytes(joints) {
                 self.island_rest.clone()
             } else {
@@ -202,15 +201,8 @@ impl WorldData {
     /// `listed_body` in bindings.wgsl), the statics, and the bodies kept
     /// out of the grid into the tail of the grid's part of `sorted`, where
     /// the passes read them.
-    pub(super) fn upload(
-        &self,
-        gpu: &Gpu,
-        props: &[BodyProps],
-        states: &[BodyState],
-        large: &[u32],
-        hulls: &[[f32; 4]],
-        joints: &JointLists,
-    ) {
+    pub(super) fn upload(&self, gpu: &Gpu, props: &[BodyProps], states: &[BodyState], statics: &Statics) {
+        let Statics { large, hulls, joints } = *statics;
         let queue = &gpu.queue;
         let write = |buffer: &wgpu::Buffer, at: u64, bytes: &[u8]| {
             if !bytes.is_empty() {
@@ -385,12 +377,13 @@ fn island_rest_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffe
 }
 
 /// The statics (`WorldData::statics`), exactly as large as their lists.
-fn statics_buffers(device: &wgpu::Device, large: &[u32], hulls: &[[f32; 4]], joints: &JointLists) -> [wgpu::Buffer; 4] {
+fn statics_buffers(device: &wgpu::Device, statics: &Statics) -> [wgpu::Buffer; 4] {
+    let Statics { large, hulls, joints } = *statics;
     [
         storage_buffer(device, "grid/large", (4 * large.len()) as u64),
         storage_buffer(device, "joints/start", (4 * joints.starts.len()) as u64),
         storage_buffer(device, "joints/refs", (joints.refs.len() * size_of::<JointRef>()) as u64),
-        storage_buffer(device, "hulls", (hulls.len() * size_of::<[f32; 4]>()) as u64),
+        storage_buffer(device, "hulls", size_of_val(hulls) as u64),
     ]
 }
 

@@ -15,7 +15,7 @@
 use std::mem::{offset_of, size_of};
 use std::ops::Range;
 
-use super::buffers::WorldData;
+use super::buffers::{Statics, WorldData};
 use super::{capacity, initial_state, joint_lists, scene_props, World};
 use crate::gpu::status::Status;
 use crate::gpu::types::{BodyProps, BodyState};
@@ -112,10 +112,11 @@ impl World {
         // outgrown buffers are made with room for half as many bodies again
         // (within what the adapter holds, checked above for n)
         let room = n.saturating_add(n / 2).min(capacity::max_bodies(&self.gpu) as usize).max(n);
-        let mut data = self.refit(n, room, &large, &hulls, &joints)?;
+        let statics = Statics { large: &large, hulls: &hulls, joints: &joints };
+        let mut data = self.refit(n, room, &statics)?;
 
         // from here on nothing fails but a lost device
-        data.upload(&self.gpu, &props, &states, &large, &hulls, &joints);
+        data.upload(&self.gpu, &props, &states, &statics);
         self.reset_status(&data, &status, removed);
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("edit") });
         // no body has woken another yet (`PairMeta::woken`), and no contacts
@@ -149,18 +150,11 @@ impl World {
     /// or why they could not be had: the allocations run in an error scope
     /// of their own, so that a refusal leaves the world and its device as
     /// they were.
-    fn refit(
-        &self,
-        n: usize,
-        room: usize,
-        large: &[u32],
-        hulls: &[[f32; 4]],
-        joints: &super::records::JointLists,
-    ) -> Result<WorldData, Error> {
+    fn refit(&self, n: usize, room: usize, statics: &Statics) -> Result<WorldData, Error> {
         let device = &self.gpu.device;
         let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let data = self.data.refit(&self.gpu, n, room, large, hulls, joints, self.settings.substeps);
+        let data = self.data.refit(&self.gpu, n, room, statics, self.settings.substeps);
         let errors = [pollster::block_on(validation.pop()), pollster::block_on(memory.pop())];
         match errors.into_iter().flatten().next() {
             Some(e) => Err(Error::Capacity(format!(

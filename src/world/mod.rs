@@ -30,7 +30,7 @@ mod records;
 pub mod snapshot;
 mod status;
 
-use buffers::WorldData;
+use buffers::{Statics, WorldData};
 use pools::PoolWatch;
 
 pub use capacity::{
@@ -119,7 +119,8 @@ impl World {
         let settings = scene.settings;
         let (props, large, grid, hulls) = scene_props(scene);
         let states: Vec<BodyState> = scene.bodies.iter().map(|b| initial_state(b, &settings)).collect();
-        let mut data = WorldData::new(&gpu, n, &props, &states, &large, &hulls, &joints, settings.substeps);
+        let mut data =
+            WorldData::new(&gpu, n, &props, &states, &Statics { large: &large, hulls: &hulls, joints: &joints }, settings.substeps);
         let (_, manifold_capacity) = pair_capacities(&gpu, n.max(1) as u64);
         let pipelines = StepPipelines::new(&gpu, capacity::pool_in_parts(&gpu, manifold_capacity));
         data.bind_groups = Some(data.step_bind_groups(&gpu.device, &pipelines));

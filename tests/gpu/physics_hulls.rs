@@ -99,8 +99,8 @@ fn a_pile_of_hulls_settles_without_passing_through() {
         shape: ShapeKind::from(&scene.bodies[i].shape),
     };
     let (mut lowest, mut deepest) = (f32::MAX, 0.0f32);
-    for i in 0..count {
-        lowest = corners(&scene.bodies[i], &state[i]).iter().map(|c| c.y).fold(lowest, f32::min);
+    for (i, s) in state.iter().enumerate().take(count) {
+        lowest = corners(&scene.bodies[i], s).iter().map(|c| c.y).fold(lowest, f32::min);
         for j in i + 1..scene.bodies.len() {
             if let Some(m) = collide(&placed(i), &placed(j), 0.0) {
                 deepest = deepest.max(m.points.iter().map(|p| -p.separation(m.normal)).fold(0.0, f32::max));
