@@ -8,6 +8,7 @@
 // The most points a face clipped by another can have: its corners and one
 // per side of the other (64 each at most, `HullShape`).
 const MAX_CLIP: u32 = 128u;
+const CLIP_ROOM: u32 = 256u;
 
 // A polytope placed in the world.
 struct Solid {
@@ -237,13 +238,15 @@ fn face_contact(reference: Poly, face: u32, incident: Poly, rel: Relative, margi
             inc = f;
         }
     }
-    var polygon: array<vec3<f32>, MAX_CLIP>;
-    var kept: array<vec3<f32>, MAX_CLIP>;
+    // the polygon clipped from one half of `clip` into the other, in turns
+    // (no copy of the whole array a side: lavapipe keeps it in memory)
+    var clip: array<vec3<f32>, CLIP_ROOM>;
     let inc_run = poly_face_run(incident, inc);
     var count = inc_run.y;
     for (var k = 0u; k < inc_run.y; k = k + 1u) {
-        polygon[k] = rel.m * poly_corner(incident, poly_index(incident, inc_run.x + k)) + rel.t;
+        clip[k] = rel.m * poly_corner(incident, poly_index(incident, inc_run.x + k)) + rel.t;
     }
+    var src = 0u;
     // Sutherland-Hodgman against each side plane of the reference face
     let run = poly_face_run(reference, face);
     for (var k = 0u; k < run.y; k = k + 1u) {
@@ -251,31 +254,34 @@ fn face_contact(reference: Poly, face: u32, incident: Poly, rel: Relative, margi
         let q = poly_corner(reference, poly_index(reference, run.x + (k + 1u) % run.y));
         let side = cross(q - p, n);
         let offset = dot(side, p);
+        let dst = MAX_CLIP - src;
         var out = 0u;
         for (var i = 0u; i < count; i = i + 1u) {
-            let s = polygon[i];
-            let e = polygon[(i + 1u) % count];
+            let s = clip[src + i];
+            let e = clip[src + (i + 1u) % count];
             let ds = dot(side, s) - offset;
             let de = dot(side, e) - offset;
             if (ds <= 0.0 && out < MAX_CLIP) {
-                kept[out] = s;
+                clip[dst + out] = s;
                 out = out + 1u;
             }
             if ((ds <= 0.0) != (de <= 0.0) && out < MAX_CLIP) {
-                kept[out] = s + (e - s) * (ds / (ds - de));
+                clip[dst + out] = s + (e - s) * (ds / (ds - de));
                 out = out + 1u;
             }
         }
-        polygon = kept;
+        src = dst;
         count = out;
     }
     // the points within the margin of the plane, and their heights
+    var kept: array<vec3<f32>, MAX_CLIP>;
     var heights: array<f32, MAX_CLIP>;
     var near = 0u;
     for (var i = 0u; i < count; i = i + 1u) {
-        let height = dot(n, polygon[i]) - plane.w;
+        let x = clip[src + i];
+        let height = dot(n, x) - plane.w;
         if (height <= margin) {
-            kept[near] = polygon[i];
+            kept[near] = x;
             heights[near] = height;
             near = near + 1u;
         }
