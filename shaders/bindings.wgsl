@@ -400,6 +400,11 @@ fn poly_index(h: Poly, k: u32) -> u32 {
     return select(select(select(w.w, w.z, j == 2u), w.y, j == 1u), w.x, j == 0u);
 }
 
+// The sphere about the corners' box: centre (xyz), radius (w).
+fn poly_sphere(h: Poly) -> vec4<f32> {
+    return hulls[h.first + 1u + h.corners + 2u * h.faces + h.index_words + h.edges];
+}
+
 // Edge e: its two corners and the faces on either side.
 fn poly_edge(h: Poly, e: u32) -> vec4<u32> {
     return bitcast<vec4<u32>>(hulls[h.first + 1u + h.corners + 2u * h.faces + h.index_words + e]);

@@ -33,8 +33,9 @@ struct FaceAxis {
     face: u32,
 }
 
-// The face of a that separates b (placed in a's frame by rel) the most.
-fn best_face(a: Poly, b: Poly, rel: Relative) -> FaceAxis {
+// The face of a that separates b (placed in a's frame by rel) the most, or
+// the first that separates them by more than `margin`.
+fn best_face(a: Poly, b: Poly, rel: Relative, margin: f32) -> FaceAxis {
     var best = FaceAxis(-3.4e38, 0u);
     let back = transpose(rel.m);
     for (var f = 0u; f < a.faces; f = f + 1u) {
@@ -47,6 +48,10 @@ fn best_face(a: Poly, b: Poly, rel: Relative) -> FaceAxis {
         let sep = lowest + dot(plane.xyz, rel.t) - plane.w;
         if (sep > best.sep) {
             best = FaceAxis(sep, f);
+        }
+        // most candidate pairs of a large hull (a drum's panel) are far apart
+        if (sep > margin) {
+            return best;
         }
     }
     return best;
@@ -315,8 +320,11 @@ fn hull_hull(a: Solid, b: Solid, margin: f32) -> Manifold {
     let none = empty_manifold();
     let rel_b = relative(a, b);
     let rel_a = relative(b, a);
-    let face_a = best_face(a.poly, b.poly, rel_b);
-    let face_b = best_face(b.poly, a.poly, rel_a);
+    let face_a = best_face(a.poly, b.poly, rel_b, margin);
+    if (face_a.sep > margin) {
+        return none;
+    }
+    let face_b = best_face(b.poly, a.poly, rel_a, margin);
     let face_sep = max(face_a.sep, face_b.sep);
     if (face_sep > margin) {
         return none;
@@ -650,7 +658,9 @@ fn ground_hull(a: Solid, ground: f32, margin: f32) -> Manifold {
 }
 
 // Bodies i and j, one a hull at least (j may be GROUND), within `margin`:
-// their manifold, normal from i to j.
+// their manifold, normal from i to j. Bodies whose bounding spheres are
+// apart have none: a kinematic drum panel's frame is the drum's axis, so
+// the broadphase pairs it with all the drum holds.
 fn collide_hull(i: u32, j: u32, margin: f32) -> Manifold {
     let pi = props_of(i);
     let si = state_of(i);
@@ -659,21 +669,39 @@ fn collide_hull(i: u32, j: u32, margin: f32) -> Manifold {
     }
     let pj = props_of(j);
     let sj = state_of(j);
+    let a = Solid(poly_of(pi), si.pos, si.rot);
+    let b = Solid(poly_of(pj), sj.pos, sj.rot);
+    let sa = bounding_sphere(a, pi);
+    let sb = bounding_sphere(b, pj);
+    if (length(sb.xyz - sa.xyz) > sa.w + sb.w + margin) {
+        return empty_manifold();
+    }
     let round_i = pi.shape == SHAPE_SPHERE || pi.shape == SHAPE_CAPSULE;
     let round_j = pj.shape == SHAPE_SPHERE || pj.shape == SHAPE_CAPSULE;
     if (round_i || round_j) {
         // the hull first
-        let hull = select(i, j, round_i);
+        var hull = a;
+        if (round_i) {
+            hull = b;
+        }
         let other = select(j, i, round_i);
-        let ph = props_of(hull);
-        let sh = state_of(hull);
         let po = props_of(other);
         let so = state_of(other);
-        let m = hull_round(Solid(poly_of(ph), sh.pos, sh.rot), swept_of(Shape(so.pos, so.rot, po.half_extents.xyz, po.shape)), margin);
+        let m = hull_round(hull, swept_of(Shape(so.pos, so.rot, po.half_extents.xyz, po.shape)), margin);
         if (round_i) {
             return flip_manifold(m);
         }
         return m;
     }
-    return hull_hull(Solid(poly_of(pi), si.pos, si.rot), Solid(poly_of(pj), sj.pos, sj.rot), margin);
+    return hull_hull(a, b, margin);
+}
+
+// A body's bounding sphere (centre, radius): a hull's about its corners'
+// box, any other's about its centre.
+fn bounding_sphere(a: Solid, p: BodyProps) -> vec4<f32> {
+    if (p.shape == SHAPE_HULL) {
+        let s = poly_sphere(a.poly);
+        return vec4<f32>(a.pos + quat_rotate(a.rot, s.xyz), s.w);
+    }
+    return vec4<f32>(a.pos, p.half_extents.w);
 }

@@ -15,6 +15,7 @@
 //! | faces | each face's run of corner indices: first, count (u32 bits in x, y) |
 //! | indices / 4, rounded up | the faces' corner indices, four to a word (u32 bits) |
 //! | edges | each edge: its two corners and its two faces (u32 bits) |
+//! | 1 | the sphere about its corners' box: its centre (xyz) and radius (w) |
 //!
 //! A body's props name its run's first word (`BodyProps::hull`).
 
@@ -108,6 +109,15 @@ fn push_run(words: &mut Vec<[f32; 4]>, hull: &Hull, centre: DVec3, axes: DQuat) 
     for e in edges {
         words.push(e.map(bits));
     }
+    // a kinematic panel's corners lie far from its frame's origin: the sphere
+    // about them keeps the narrowphase from testing the pairs it never meets
+    let kept: Vec<DVec3> = hull.vertices.iter().map(|v| to_kept(*v)).collect();
+    let lo = kept.iter().fold(DVec3::splat(f64::MAX), |a, &p| a.min(p));
+    let hi = kept.iter().fold(DVec3::splat(f64::MIN), |a, &p| a.max(p));
+    let centre = (lo + hi) * 0.5;
+    // rounded up, so that no corner lies outside it
+    let radius = kept.iter().map(|p| (*p - centre).length()).fold(0.0, f64::max) * (1.0 + 1e-6) + 1e-6;
+    words.push([centre.x as f32, centre.y as f32, centre.z as f32, radius as f32]);
 }
 
 /// Each edge of `hull` once: its two corners and the faces on either side
@@ -170,8 +180,11 @@ mod tests {
         let runs = &words[15..21];
         assert_eq!(runs.iter().map(|r| r[1].to_bits()).sum::<u32>(), 24);
         let index_words = 24usize.div_ceil(4);
-        let edges = &words[21 + index_words..];
+        let edges = &words[21 + index_words..words.len() - 1];
         assert_eq!(edges.len(), 12);
+        // the sphere about the cube: its centre, reaching every corner
+        let sphere = words[words.len() - 1];
+        assert!(sphere[..3].iter().all(|v| v.abs() < 1e-6) && (sphere[3] - 0.75f32.sqrt()).abs() < 1e-5, "{sphere:?}");
         assert!(edges.iter().all(|e| e[2].to_bits() != e[3].to_bits()));
         // every face's corners lie on its plane
         let indices: Vec<u32> = words[21..21 + index_words].iter().flat_map(|w| w.map(f32::to_bits)).collect();
