@@ -410,18 +410,45 @@ fn poly_edge(h: Poly, e: u32) -> vec4<u32> {
     return bitcast<vec4<u32>>(hulls[h.first + 1u + h.corners + 2u * h.faces + h.index_words + e]);
 }
 
-// world_extent, for every shape: a hull's from its corners.
+// world_extent, for every shape: a hull's from its corners, about
+// `bound_offset`.
 fn body_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     if (p.shape != SHAPE_HULL) {
         return world_extent(s, p);
     }
     let h = poly_of(p);
     let r = quat_to_mat(s.rot);
+    let c = bound_offset(p);
     var extent = vec3<f32>(0.0);
     for (var k = 0u; k < h.corners; k = k + 1u) {
-        extent = max(extent, abs(r * poly_corner(h, k)));
+        extent = max(extent, abs(r * (poly_corner(h, k) - c)));
     }
     return extent;
+}
+
+// Where a body's broadphase bounds (pair_meta's extent and bound) are
+// centred, in its frame: its origin, but for a hull kept out of the grid
+// the centre of its corners' box (a drum panel's frame is the drum's axis;
+// bounds about it held every body in the drum).
+fn bound_offset(p: BodyProps) -> vec3<f32> {
+    if (p.shape == SHAPE_HULL && p.grid_class == LARGE_BODY) {
+        return poly_sphere(poly_of(p)).xyz;
+    }
+    return vec3<f32>(0.0);
+}
+
+// The bounding radius about bound_offset.
+fn bound_radius(p: BodyProps) -> f32 {
+    if (p.shape == SHAPE_HULL && p.grid_class == LARGE_BODY) {
+        return poly_sphere(poly_of(p)).w;
+    }
+    return p.half_extents.w;
+}
+
+// The world centre of a body kept out of the grid's bounds (bound_offset).
+fn large_centre(j: u32) -> vec3<f32> {
+    let s = state_of(j);
+    return s.pos + quat_rotate(s.rot, bound_offset(props_of(j)));
 }
 
 // reach_along, for every shape: a hull's farthest corner along dir.

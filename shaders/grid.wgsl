@@ -116,7 +116,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     pair_meta[i].spin = spin;
     pair_meta[i].extent = body_extent(s, p) + vec3<f32>(reach + spin);
     // the bounding sphere turns into itself: only the centre's move grows it
-    pair_meta[i].bound = p.half_extents.w + reach;
+    pair_meta[i].bound = bound_radius(p) + reach;
     if (!grid_body(p)) {
         return;
     }
@@ -286,6 +286,13 @@ fn grid_key(i: u32) -> f32 {
 @compute @workgroup_size(WORKGROUP)
 fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
+    // the bounds of the bodies kept out of the grid go after the grid's, in
+    // their order (`large_body`): every walk reads them, once each here
+    if (i < params.large_count) {
+        let j = large_body(i);
+        let bound = CellBound(large_centre(j), pair_meta[j].bound, pair_meta[j].extent, j | (pair_meta[j].moves << MOVES_SHIFT));
+        set_cell_bound(params.body_count - params.large_count + i, bound);
+    }
     if (i >= params.body_count || !in_grid(i)) {
         return;
     }

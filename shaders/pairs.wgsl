@@ -39,10 +39,10 @@ fn wanted_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u
     return (walker.moves || moves_j == MOVES) && dot(d, d) <= spheres * spheres && all(apart <= vec3<f32>(CONTACT_MARGIN));
 }
 
-// Whether body i is near enough the ground for a ground pair.
-fn wants_ground(i: u32) -> bool {
+// Whether body i, its bounds centred at `centre`, is near enough the ground for a ground pair.
+fn wants_ground(i: u32, centre: vec3<f32>) -> bool {
     return params.has_ground != 0u && pair_meta[i].moves == MOVES
-        && state_of(i).pos.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
+        && centre.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
 }
 
 // Whether the walker owns its pair with body j (box size `size_j`) when one is
@@ -185,11 +185,15 @@ fn walk(i: u32) {
     let size = box_size(extent);
     let grid = in_grid(i);
     let sleeps = pair_meta[i].moves == SLEEPS;
-    walker = Walker(i, state_of(i).pos, extent, pair_meta[i].bound, size, pair_meta[i].moves == MOVES,
+    var centre_i = state_of(i).pos;
+    if (!grid) {
+        centre_i = large_centre(i);
+    }
+    walker = Walker(i, centre_i, extent, pair_meta[i].bound, size, pair_meta[i].moves == MOVES,
                     grid && is_fast(size, pair_meta[i].moves));
     owned = 0u;
     trips = 0u;
-    if (wants_ground(i)) {
+    if (wants_ground(i, walker.pos)) {
         if (writing) {
             write_owned(GROUND);
         } else {
@@ -229,7 +233,8 @@ fn walk(i: u32) {
     for (var k = 0u; k < params.large_count; k = k + 1u) {
         trips = trips + 1u;
         let j = large_body(k);
-        if ((grid || j > i) && wanted_bounds(state_of(j).pos, pair_meta[j].bound, pair_meta[j].extent, pair_meta[j].moves)) {
+        let cb = cell_bound_of(params.body_count - params.large_count + k);
+        if ((grid || j > i) && wanted_bounds(cb.pos, cb.bound, cb.extent, cb.body >> MOVES_SHIFT)) {
             take(j);
         }
     }

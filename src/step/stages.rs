@@ -206,12 +206,12 @@ pub(crate) const TABLE: [StageInfo; 24] = {
             ..S::row(Stage::GridScatter, "grid_scatter", GRID_PASS, Broadphase)
         },
         S {
-            reads: &[Params, Props, StateIn, CellStart, Sorted, PairMeta],
+            reads: &[Params, Props, StateIn, CellStart, Sorted, PairMeta, Hulls],
             writes: &[Sorted, CellBounds],
             ..S::row(Stage::GridSort, "grid_sort", GRID_PASS, Broadphase)
         },
         S {
-            reads: &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds],
+            reads: &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds, Hulls],
             writes: &[Sorted, Pairs, Status, PairMeta, BodyPairs],
             ..S::row(Stage::PairsCount, "pairs_count", PAIRS_PASS, Narrowphase)
         },
@@ -233,7 +233,7 @@ pub(crate) const TABLE: [StageInfo; 24] = {
             ..S::row(Stage::PairsScanSums, "pairs_scan_sums", GRID_PASS, Narrowphase)
         },
         S {
-            reads: &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds],
+            reads: &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds, Hulls],
             writes: &[Pairs, PairMeta, BodyPairs],
             ..S::row(Stage::PairsWrite, "pairs_write", PAIRS_PASS, Narrowphase)
         },
