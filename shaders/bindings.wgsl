@@ -388,6 +388,12 @@ fn poly_plane(h: Poly, f: u32) -> vec4<f32> {
     return vec4<f32>(n * inv, w.w * inv);
 }
 
+// Face f's outward unit normal: a hull's as stored, a box's the cube's
+// (its axes, which scaling leaves as they are).
+fn poly_normal(h: Poly, f: u32) -> vec3<f32> {
+    return hulls[h.first + 1u + h.corners + f].xyz;
+}
+
 // Face f's corner indices: the first's place among the indices, and the count.
 fn poly_face_run(h: Poly, f: u32) -> vec2<u32> {
     return bitcast<vec2<u32>>(hulls[h.first + 1u + h.corners + h.faces + f].xy);

@@ -78,22 +78,24 @@ struct EdgeAxis {
     edge_b: u32,
 }
 
-// The edge pair whose axis separates the two the most, in a's frame.
+// The edge pair whose axis separates the two the most, in a's frame. The
+// outer loop takes b's edges into a's frame, so the inner one, over a's,
+// transforms nothing.
 fn best_edges(a: Poly, b: Poly, rel: Relative) -> EdgeAxis {
     var best = EdgeAxis(-3.4e38, vec3<f32>(0.0, 1.0, 0.0), 0u, 0u);
-    for (var i = 0u; i < a.edges; i = i + 1u) {
-        let ea = poly_edge(a, i);
-        let a0 = poly_corner(a, ea.x);
-        let da = poly_corner(a, ea.y) - a0;
-        let na1 = poly_plane(a, ea.z).xyz;
-        let na2 = poly_plane(a, ea.w).xyz;
-        for (var j = 0u; j < b.edges; j = j + 1u) {
-            let eb = poly_edge(b, j);
-            let nb1 = rel.m * poly_plane(b, eb.z).xyz;
-            let nb2 = rel.m * poly_plane(b, eb.w).xyz;
+    for (var j = 0u; j < b.edges; j = j + 1u) {
+        let eb = poly_edge(b, j);
+        let nb1 = rel.m * poly_normal(b, eb.z);
+        let nb2 = rel.m * poly_normal(b, eb.w);
+        let b0 = rel.m * poly_corner(b, eb.x) + rel.t;
+        let db = rel.m * poly_corner(b, eb.y) + rel.t - b0;
+        for (var i = 0u; i < a.edges; i = i + 1u) {
+            let ea = poly_edge(a, i);
+            let na1 = poly_normal(a, ea.z);
+            let na2 = poly_normal(a, ea.w);
             if (minkowski_face(na1, na2, nb1, nb2)) {
-                let b0 = rel.m * poly_corner(b, eb.x) + rel.t;
-                let db = rel.m * poly_corner(b, eb.y) + rel.t - b0;
+                let a0 = poly_corner(a, ea.x);
+                let da = poly_corner(a, ea.y) - a0;
                 let l = cross(da, db);
                 let len = length(l);
                 if (len >= 1e-5 * length(da) * length(db)) {

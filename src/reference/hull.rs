@@ -110,16 +110,18 @@ fn minkowski_face(a1: Vec3, a2: Vec3, b1: Vec3, b2: Vec3) -> bool {
     cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0
 }
 
-/// The best edge axis: its separation, normal (from a to b) and the edges.
+/// The best edge axis: its separation, normal (from a to b) and the edges;
+/// b's edges outside, a's inside, as the GPU takes them (the first of
+/// equals wins).
 fn best_edges(a: &Polytope, b: &Polytope) -> (f32, Vec3, usize, usize) {
     let mut best = (f32::MIN, Vec3::Y, 0, 0);
-    for (i, &(a0, a1, fa, ga)) in a.edges.iter().enumerate() {
-        let ea = a.vertices[a1] - a.vertices[a0];
-        for (j, &(b0, b1, fb, gb)) in b.edges.iter().enumerate() {
+    for (j, &(b0, b1, fb, gb)) in b.edges.iter().enumerate() {
+        let eb = b.vertices[b1] - b.vertices[b0];
+        for (i, &(a0, a1, fa, ga)) in a.edges.iter().enumerate() {
             if !minkowski_face(a.faces[fa].0, a.faces[ga].0, b.faces[fb].0, b.faces[gb].0) {
                 continue;
             }
-            let eb = b.vertices[b1] - b.vertices[b0];
+            let ea = a.vertices[a1] - a.vertices[a0];
             let l = ea.cross(eb);
             let len = l.length();
             if len < 1e-5 * ea.length() * eb.length() {
