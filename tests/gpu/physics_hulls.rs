@@ -191,3 +191,34 @@ fn cubes_tumble_in_a_turning_drum_without_leaving_it() {
     assert!(highest > -0.5, "the cubes were not carried up: highest {highest} m about the axis");
     assert!(speed > 0.2, "the cubes do not tumble: mean speed {speed} m/s");
 }
+
+/// Hulls added to a world that had none, and one of them taken out again:
+/// the world makes their records then, and they land and rest on the
+/// ground and on a box as those loaded with the scene do.
+#[test]
+fn hulls_added_to_a_world_land_and_rest() {
+    let mut scene = scenes::stack(1);
+    scene.bodies[0].position = [3.0, 0.5, 0.0];
+    let Some(mut w) = world(&scene) else { return };
+    w.step(10).unwrap();
+    let added = [
+        hull(TETRA.to_vec(), Vec3::new(0.0, 0.3, 0.0), Quat::IDENTITY),
+        hull(TETRA.to_vec(), Vec3::new(2.8, 1.3, -0.2), Quat::IDENTITY),
+        hull(TETRA.to_vec(), Vec3::new(-3.0, 0.3, 0.0), Quat::IDENTITY),
+    ];
+    assert_eq!(w.add_bodies(&added, &[]).unwrap(), 1..4);
+    w.remove_body(3).unwrap();
+    w.step(180).unwrap();
+    let state = w.read_state().unwrap();
+    let on_ground = corners(&added[0], &state[1]);
+    let on_box = corners(&added[1], &state[2]);
+    eprintln!("added hulls after 3 s: on the ground {on_ground:?}, on the box {on_box:?}");
+    for (k, c) in on_ground.iter().enumerate() {
+        let expected = if k == 3 { 1.0 } else { 0.0 };
+        assert!((c.y - expected).abs() < 3e-3, "on the ground: corner {k} at {}", c.y);
+    }
+    for (k, c) in on_box.iter().enumerate() {
+        let expected = if k == 3 { 2.0 } else { 1.0 };
+        assert!((c.y - expected).abs() < 3e-3, "on the box: corner {k} at {}", c.y);
+    }
+}
