@@ -192,3 +192,26 @@ fn gpu_hull_ground_manifolds_match_the_cpu_reference() {
     assert!(touching > 100, "too few touching: {touching}");
     assert!(mismatched.len() <= 2, "{} of 200 differ: {mismatched:?}", mismatched.len());
 }
+
+/// A hull of the most points a hull may have (64, on a sphere: 124
+/// triangles and 186 edges), or a box: the edge pairs' loop of two such
+/// hulls is the longest a pair takes, and lavapipe ends an invocation's loops
+/// past 65 535 trips in all; the manifolds still match the reference.
+fn largest_hull_or_box(rng: &mut Rng, k: usize, at: Vec3) -> Body {
+    if k % 4 == 3 {
+        return random_body(rng, k, at);
+    }
+    let r = 0.4 + 0.4 * rng.f();
+    let points =
+        (0..64).map(|_| (Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y) * r).to_array()).collect();
+    let mut b = Body::new(Shape::Hull(HullShape::new(points).unwrap()), at.to_array());
+    b.orientation = rng.quat().to_array();
+    b
+}
+
+#[test]
+fn gpu_manifolds_of_the_largest_hulls_match_the_cpu_reference() {
+    let Some((touching, mismatched)) = compare(0x5eed_4011_0000_0064, 100, largest_hull_or_box) else { return };
+    assert!(touching > 30, "too few touching pairs to compare: {touching}");
+    assert!(mismatched.len() <= 2, "{} of 100 pairs differ from the reference", mismatched.len());
+}
