@@ -14,7 +14,7 @@
 // keeps its precision from the near plane to the horizon.
 
 // BodyState, quat_rotate and SHAPE_* come from common.wgsl and the shared
-// constants; HULL_MESH is the renderer's own, written before common.wgsl.
+// constants.
 
 // The renderer's constants (208 bytes), written once; `Globals` in src/render/gpu.rs.
 struct Globals {
@@ -46,7 +46,7 @@ struct RenderBody {
     body: u32,
     // linear RGB
     color: vec3<f32>,
-    // SHAPE_BOX, SHAPE_SPHERE, SHAPE_CAPSULE or HULL_MESH
+    // SHAPE_BOX, SHAPE_SPHERE, SHAPE_CAPSULE or SHAPE_HULL
     shape: u32,
 }
 
@@ -175,7 +175,7 @@ fn body_fragment(in: BodyOut) -> @location(0) vec4<f32> {
     var albedo = in.color;
     if in.shape == SHAPE_BOX {
         albedo = albedo * (1.0 - 0.5 * edge);
-    } else if in.shape != HULL_MESH {
+    } else if in.shape != SHAPE_HULL {
         albedo = mix(albedo, vec3<f32>(1.0), 0.5 * octant);
     }
     // a hull keeps its colour: its flat faces already read apart, and turn with it

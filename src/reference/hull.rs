@@ -36,7 +36,8 @@ impl Polytope {
                 (n, n.dot(at) + f.offset as f32, f.corners.clone())
             })
             .collect();
-        Polytope::with_edges(vertices, faces, at + rot * hull.centroid.as_vec3())
+        let edges = hull.edges().into_iter().map(|[a, b, f, g]| (a, b, f, g)).collect();
+        Polytope { vertices, faces, edges, centre: at + rot * hull.centroid.as_vec3() }
     }
 
     /// A box of half extents `h` at `at`, turned by `rot`.
@@ -48,24 +49,6 @@ impl Polytope {
             })
             .collect();
         Polytope::from_hull(&Hull::new(&points).expect("a box spans a volume"), at, rot)
-    }
-
-    fn with_edges(vertices: Vec<Vec3>, faces: Vec<(Vec3, f32, Vec<usize>)>, centre: Vec3) -> Polytope {
-        // each edge once, from the face that walks it from its lower corner
-        let mut edges = Vec::new();
-        for (f, (_, _, corners)) in faces.iter().enumerate() {
-            for k in 0..corners.len() {
-                let (a, b) = (corners[k], corners[(k + 1) % corners.len()]);
-                if a < b {
-                    let other = faces
-                        .iter()
-                        .position(|(_, _, c)| (0..c.len()).any(|j| c[j] == b && c[(j + 1) % c.len()] == a))
-                        .expect("a closed hull: every edge has a face on each side");
-                    edges.push((a, b, f, other));
-                }
-            }
-        }
-        Polytope { vertices, faces, edges, centre }
     }
 
     /// The polytope moved by `by`.

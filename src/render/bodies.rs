@@ -7,10 +7,11 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::gpu::{JointLine, RenderBody, HULL_MESH};
+use super::gpu::{JointLine, RenderBody};
 use super::mesh::{hull_mesh, MeshVertex};
-use crate::gpu::types::{SHAPE_BOX, SHAPE_CAPSULE, SHAPE_SPHERE};
+use crate::gpu::types::{SHAPE_BOX, SHAPE_CAPSULE, SHAPE_HULL, SHAPE_SPHERE};
 use crate::scene::{Body, Scene, Shape};
+use crate::world::{hull_key, local_anchor};
 
 /// Background (sRGB): a pale sky; the ground fades into it.
 pub(super) const BACKGROUND_SRGB: [f32; 3] = [0.80, 0.85, 0.90];
@@ -72,12 +73,9 @@ impl Instances {
         let mut shape_of: HashMap<Vec<u32>, usize> = HashMap::new();
         for (i, b) in scene.bodies.iter().enumerate() {
             let Shape::Hull(h) = &b.shape else { continue };
-            let frame = b.mass_frame();
-            let mut key: Vec<u32> = h.points().iter().flatten().map(|v| v.to_bits()).collect();
-            key.push(u32::from(frame.is_some()));
-            let k = *shape_of.entry(key).or_insert_with(|| {
+            let k = *shape_of.entry(hull_key(b, h)).or_insert_with(|| {
                 let start = hull_mesh_vertices.len() as u32;
-                hull_mesh_vertices.extend(hull_mesh(h.hull(), frame));
+                hull_mesh_vertices.extend(hull_mesh(h.hull(), b.mass_frame()));
                 shapes.push((start..hull_mesh_vertices.len() as u32, Vec::new()));
                 shapes.len() - 1
             });
@@ -87,7 +85,7 @@ impl Instances {
         for (vertices, members) in shapes {
             let first = instances.len() as u32;
             // the mesh is in metres already: unscaled
-            instances.extend(members.into_iter().map(|i| record(i, &scene.bodies[i], [1.0; 3], HULL_MESH)));
+            instances.extend(members.into_iter().map(|i| record(i, &scene.bodies[i], [1.0; 3], SHAPE_HULL)));
             hull_runs.push(HullRun { vertices, slots: first..instances.len() as u32 });
         }
 
@@ -103,15 +101,7 @@ impl Instances {
 /// frames the bodies' poses are kept in (`Body::mass_frame`), as the
 /// state buffer holds them.
 pub(super) fn joint_lines(scene: &Scene) -> Vec<JointLine> {
-    let anchor = |j: &crate::scene::Joint, k: usize| match usize::try_from(j.bodies[k]) {
-        Ok(b) => match scene.bodies[b].mass_frame() {
-            Some((centre, axes)) => {
-                (axes.conjugate() * (glam::DVec3::from_array(j.anchors[k].map(f64::from)) - centre)).as_vec3().to_array()
-            }
-            None => j.anchors[k],
-        },
-        Err(_) => j.anchors[k],
-    };
+    let anchor = |j: &crate::scene::Joint, k: usize| local_anchor(scene, j, k);
     scene
         .joints
         .iter()
@@ -178,7 +168,7 @@ mod tests {
         // a tetrahedron is 4 triangles, the wedge 8; the kinematic one has its own mesh
         assert_eq!(runs, vec![(0..12, 2..4), (12..36, 4..5), (36..48, 5..6)]);
         assert_eq!(inst.hull_mesh.len(), 48);
-        assert!(inst.bodies[2..].iter().all(|r| r.shape == HULL_MESH && r.half_extents == [1.0; 3]));
+        assert!(inst.bodies[2..].iter().all(|r| r.shape == SHAPE_HULL && r.half_extents == [1.0; 3]));
         for (body, &slot) in inst.slot_of_body.iter().enumerate() {
             assert_eq!(inst.bodies[slot as usize].body, body as u32);
         }

@@ -17,13 +17,8 @@ pub(crate) const RENDER: &str = include_str!("../../shaders/render.wgsl");
 /// The WGSL of every render pipeline: the shared constants, common.wgsl (the
 /// body's pose and the quaternion helpers; it binds nothing), render.wgsl.
 pub fn shader_source() -> String {
-    let own = format!("// The renderer's own, from src/render/gpu.rs.\nconst HULL_MESH: u32 = {HULL_MESH}u;\n");
-    crate::gpu::shaders::shared_constants() + &own + crate::gpu::shaders::COMMON + RENDER
+    crate::gpu::shaders::shared_constants() + crate::gpu::shaders::COMMON + RENDER
 }
-
-/// `RenderBody::shape` of a hull, past the step's `SHAPE_*`: drawn from
-/// its own mesh, unscaled and plainly coloured.
-pub(crate) const HULL_MESH: u32 = 3;
 
 /// Samples per pixel: 4x MSAA, which WebGPU guarantees for both formats below.
 pub(crate) const SAMPLES: u32 = 4;
@@ -70,7 +65,8 @@ pub struct RenderBody {
     pub body: u32,
     /// Linear RGB.
     pub color: [f32; 3],
-    /// `SHAPE_BOX`, `SHAPE_SPHERE`, `SHAPE_CAPSULE` or `HULL_MESH`.
+    /// `SHAPE_BOX`, `SHAPE_SPHERE`, `SHAPE_CAPSULE` or `SHAPE_HULL` (drawn
+    /// from its own mesh, unscaled and plainly coloured).
     pub shape: u32,
 }
 

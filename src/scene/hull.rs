@@ -131,6 +131,26 @@ impl Hull {
         (moments, DQuat::from_mat3(&axes).normalize())
     }
 
+    /// Each edge once: its two corners, the face that walks it from the
+    /// lower corner to the higher, and the face on its other side.
+    pub fn edges(&self) -> Vec<[usize; 4]> {
+        let mut edges = Vec::new();
+        for (f, face) in self.faces.iter().enumerate() {
+            let c = &face.corners;
+            for k in 0..c.len() {
+                let (a, b) = (c[k], c[(k + 1) % c.len()]);
+                if a < b {
+                    let walks_back =
+                        |g: &Face| (0..g.corners.len()).any(|j| g.corners[j] == b && g.corners[(j + 1) % g.corners.len()] == a);
+                    // a hull is closed (`new`): every side has a face on its other side
+                    let other = self.faces.iter().position(walks_back).unwrap_or(f);
+                    edges.push([a, b, f, other]);
+                }
+            }
+        }
+        edges
+    }
+
     /// How far the hull reaches from `centre` at most (m).
     pub fn radius_about(&self, centre: DVec3) -> f64 {
         self.vertices.iter().map(|v| (*v - centre).length()).fold(0.0, f64::max)

@@ -60,9 +60,7 @@ pub(crate) fn hull_records(bodies: &[Body]) -> (Vec<[f32; 4]>, Vec<u32>) {
     let mut seen: HashMap<Vec<u32>, u32> = HashMap::new();
     for (k, body) in bodies.iter().enumerate() {
         let Shape::Hull(shape) = &body.shape else { continue };
-        let mut key: Vec<u32> = shape.points().iter().flatten().map(|v| v.to_bits()).collect();
-        key.push(u32::from(body.mass_frame().is_some()));
-        firsts[k] = *seen.entry(key).or_insert_with(|| {
+        firsts[k] = *seen.entry(hull_key(body, shape)).or_insert_with(|| {
             let first = words.len() as u32;
             let (centre, axes) = kept_frame(body);
             push_run(&mut words, shape.hull(), centre, axes);
@@ -72,12 +70,20 @@ pub(crate) fn hull_records(bodies: &[Body]) -> (Vec<[f32; 4]>, Vec<u32>) {
     (words, firsts)
 }
 
+/// What makes two hull bodies share a run (and a mesh): the same points,
+/// kept in the same kind of frame.
+pub(crate) fn hull_key(body: &Body, shape: &HullShape) -> Vec<u32> {
+    let mut key: Vec<u32> = shape.points().iter().flatten().map(|v| v.to_bits()).collect();
+    key.push(u32::from(body.mass_frame().is_some()));
+    key
+}
+
 /// Appends the run of `hull` moved into the frame at `centre` with axes `axes`.
 fn push_run(words: &mut Vec<[f32; 4]>, hull: &Hull, centre: DVec3, axes: DQuat) {
     let to_kept = |p: DVec3| axes.conjugate() * (p - centre);
     let bits = |v: u32| f32::from_bits(v);
     let indices: Vec<u32> = hull.faces.iter().flat_map(|f| f.corners.iter().map(|&c| c as u32)).collect();
-    let edges = edges_of(hull);
+    let edges = hull.edges();
     words.push([
         bits(hull.vertices.len() as u32),
         bits(hull.faces.len() as u32),
@@ -107,7 +113,7 @@ fn push_run(words: &mut Vec<[f32; 4]>, hull: &Hull, centre: DVec3, axes: DQuat) 
         words.push(word);
     }
     for e in edges {
-        words.push(e.map(bits));
+        words.push(e.map(|v| bits(v as u32)));
     }
     // a kinematic panel's corners lie far from its frame's origin: the sphere
     // about them keeps the narrowphase from testing the pairs it never meets
@@ -118,27 +124,6 @@ fn push_run(words: &mut Vec<[f32; 4]>, hull: &Hull, centre: DVec3, axes: DQuat) 
     // rounded up, so that no corner lies outside it
     let radius = kept.iter().map(|p| (*p - centre).length()).fold(0.0, f64::max) * (1.0 + 1e-6) + 1e-6;
     words.push([centre.x as f32, centre.y as f32, centre.z as f32, radius as f32]);
-}
-
-/// Each edge of `hull` once: its two corners and the faces on either side
-/// (the first walks it from the lower corner to the higher).
-pub(crate) fn edges_of(hull: &Hull) -> Vec<[u32; 4]> {
-    let mut edges = Vec::new();
-    for (f, face) in hull.faces.iter().enumerate() {
-        let c = &face.corners;
-        for k in 0..c.len() {
-            let (a, b) = (c[k], c[(k + 1) % c.len()]);
-            if a < b {
-                let other = hull
-                    .faces
-                    .iter()
-                    .position(|g| (0..g.corners.len()).any(|j| g.corners[j] == b && g.corners[(j + 1) % g.corners.len()] == a))
-                    .expect("a closed hull: every edge has a face on each side");
-                edges.push([a as u32, b as u32, f as u32, other as u32]);
-            }
-        }
-    }
-    edges
 }
 
 #[cfg(test)]

@@ -36,11 +36,12 @@ use pools::PoolWatch;
 pub use capacity::{
     body_bytes, bytes_per_body, manifold_bytes, max_bodies, pair_bytes, pair_capacities, MANIFOLDS_PER_BODY, PAIRS_PER_BODY,
 };
+pub(crate) use hull_records::hull_key;
 pub use pools::SHRINK_AFTER_STEPS;
 pub use profile::StageTimes;
 pub use readback::BodyOutput;
 pub use records::{initial_state, joint_gaps, plan_grid, GridLayout};
-pub(crate) use records::{joint_lists, scene_props};
+pub(crate) use records::{joint_lists, local_anchor, scene_props};
 pub use status::ContactReport;
 
 /// The host's side of where a batch of steps started (`World::batch_start`).

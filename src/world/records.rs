@@ -265,14 +265,19 @@ pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
     JointLists { starts, refs, islands, colours }
 }
 
+/// Anchor `k` of joint `j` in the frame its body's pose is kept in
+/// (`Body::mass_frame`); the world's as given.
+pub(crate) fn local_anchor(scene: &Scene, j: &crate::scene::Joint, k: usize) -> [f32; 3] {
+    match usize::try_from(j.bodies[k]) {
+        Ok(b) => to_mass_frame(&scene.bodies[b], j.anchors[k]),
+        Err(_) => j.anchors[k],
+    }
+}
+
 /// Joint `j` seen from its end `me` (0 or 1).
 fn joint_end(scene: &Scene, j: &crate::scene::Joint, me: usize) -> JointRef {
     let other = j.bodies[1 - me];
-    // an anchor in its body's frame, into the frame the simulation keeps
-    let local = |k: usize| match usize::try_from(j.bodies[k]) {
-        Ok(b) => to_mass_frame(&scene.bodies[b], j.anchors[k]),
-        Err(_) => j.anchors[k],
-    };
+    let local = |k: usize| local_anchor(scene, j, k);
     JointRef {
         local_self: local(me),
         partner: if other < 0 { WORLD } else { other as u32 },
