@@ -631,18 +631,24 @@ fn hull_round(a: Solid, round: Swept, margin: f32) -> Manifold {
 
 // A hull's contact with the ground within `margin`, normal from the body
 // down: its corners within the margin, reduced to four as a face contact's.
-fn ground_hull(a: Solid, ground: f32, margin: f32) -> Manifold {
+// The manifold serves the step's substeps, so corners are chosen by how low
+// the step's motion (disp and the turn from prev_rot, repeated) brings them:
+// a corner left out would sink unresisted while the body tips toward it.
+fn ground_hull(a: Solid, disp: vec3<f32>, prev_rot: vec4<f32>, ground: f32, margin: f32) -> Manifold {
     var m = empty_manifold();
     m.normal = vec3<f32>(0.0, -1.0, 0.0);
     let r = quat_to_mat(a.rot);
+    let turn = r - quat_to_mat(prev_rot);
+    let steps = f32(params.substeps);
     var corners: array<vec3<f32>, MAX_CLIP>;
     var heights: array<f32, MAX_CLIP>;
     var near = 0u;
     for (var k = 0u; k < a.poly.corners; k = k + 1u) {
-        let w = a.pos + r * poly_corner(a.poly, k);
+        let c = poly_corner(a.poly, k);
+        let w = a.pos + r * c;
         if (w.y - ground <= margin) {
             corners[near] = w;
-            heights[near] = w.y - ground;
+            heights[near] = w.y - ground + min((disp + turn * c).y * steps, 0.0);
             near = near + 1u;
         }
     }
@@ -667,7 +673,7 @@ fn collide_hull(i: u32, j: u32, margin: f32) -> Manifold {
     let pi = props_of(i);
     let si = state_of(i);
     if (j == GROUND) {
-        return ground_hull(Solid(poly_of(pi), si.pos, si.rot), params.ground_height, margin);
+        return ground_hull(Solid(poly_of(pi), si.pos, si.rot), si.disp, si.prev_rot, params.ground_height, margin);
     }
     let pj = props_of(j);
     let sj = state_of(j);

@@ -435,7 +435,8 @@ fn hull_round_near(p: &Polytope, round: &Swept, margin: f32) -> Option<Manifold>
 
 /// A hull's contact with the ground at height `ground` within `margin`,
 /// normal from the hull down: its corners within the margin, reduced to
-/// four as a face contact's.
+/// four as a face contact's. The GPU chooses the four by the heights the
+/// step's motion brings them to; for a hull at rest, as here, by the same.
 pub fn ground_hull(p: &Polytope, ground: f32, margin: f32) -> Option<Manifold> {
     let near: Vec<Vec3> = p.vertices.iter().copied().filter(|w| w.y - ground <= margin).collect();
     if near.is_empty() {

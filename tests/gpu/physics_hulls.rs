@@ -1,7 +1,8 @@
 //! Hulls with known answers: a tetrahedron rests on a face and one tipped
-//! onto an edge falls onto one, a pile of rocks settles and sleeps without
-//! passing through the ground or each other, and cubes in a drum of
-//! kinematic hull panels tumble as it turns without leaving it.
+//! onto an edge falls onto one, a slab tipped toward the corner its ground
+//! manifold left out keeps it out of the ground, a pile of rocks settles
+//! and sleeps without passing through the ground or each other, and cubes
+//! in a drum of kinematic hull panels tumble as it turns without leaving it.
 
 use crate::common::{quat, step_until_asleep, v3, world, Rng};
 use glam::{Quat, Vec3};
@@ -221,4 +222,46 @@ fn hulls_added_to_a_world_land_and_rest() {
         let expected = if k == 3 { 2.0 } else { 1.0 };
         assert!((c.y - expected).abs() < 3e-3, "on the box: corner {k} at {}", c.y);
     }
+}
+
+/// A pentagonal slab lying on its face has five corners on the ground, of
+/// which its manifold keeps four. Turned toward the one it leaves out, that
+/// corner meets the ground within the step: the manifold, found once for
+/// the step's substeps, keeps the corners the step's motion brings down, so
+/// the corner never sinks farther than a step's slop.
+#[test]
+fn a_slab_tipped_toward_a_corner_its_manifold_left_out_stays_out_of_the_ground() {
+    let points: Vec<[f32; 3]> = (0..10)
+        .map(|k| {
+            let a = (k % 5) as f32 * std::f32::consts::TAU / 5.0;
+            [0.5 * a.cos(), if k < 5 { -0.1 } else { 0.1 }, 0.5 * a.sin()]
+        })
+        .collect();
+    let mut scene = scenes::stack(0);
+    scene.bodies = vec![hull(points.clone(), Vec3::new(0.0, 0.1, 0.0), Quat::IDENTITY)];
+    let Some(mut w) = world(&scene) else { return };
+    w.step(1).unwrap();
+    let state = w.read_state().unwrap();
+    let kept: Vec<Vec3> = w.read_contacts().unwrap()[0]
+        .iter()
+        .map(|c| v3(state[0].position) + quat(state[0].orientation) * v3(c.local_self))
+        .collect();
+    let bottom = corners(&scene.bodies[0], &state[0]);
+    let left_out = (0..5).find(|&k| kept.iter().all(|p| (*p - bottom[k]).length() > 1e-3));
+    eprintln!("slab at rest: {} ground points, corner left out {left_out:?}", kept.len());
+    let Some(m) = left_out else { return };
+    // turning at 3 rad/s about the horizontal axis that lowers corner m
+    let r = Vec3::from(points[m]);
+    let mut tipped = scene.clone();
+    tipped.bodies[0].angular_velocity = (Vec3::new(r.z, 0.0, -r.x).normalize() * 3.0).to_array();
+    let Some(mut w) = world(&tipped) else { return };
+    let mut deepest = 0.0f32;
+    for _ in 0..20 {
+        w.step(1).unwrap();
+        let s = w.read_state().unwrap();
+        let low = corners(&tipped.bodies[0], &s[0]).iter().map(|c| c.y).fold(f32::MAX, f32::min);
+        deepest = deepest.min(low);
+    }
+    eprintln!("slab tipped toward corner {m}: deepest corner {deepest} m");
+    assert!(deepest > -0.004, "a corner sank {deepest} m into the ground");
 }
