@@ -7,7 +7,7 @@
 use crate::common::Rng;
 use glam::Vec3;
 use verlet::reference::capsule::Swept;
-use verlet::reference::collide::EDGE_BIAS;
+use verlet::reference::collide::{ContactPoint, Manifold, EDGE_BIAS};
 use verlet::reference::hull::{ground_hull, hull_hull, hull_round, Polytope};
 use verlet::scene::hull::Hull;
 
@@ -123,30 +123,8 @@ fn hulls_keep_to_the_true_gap() {
         let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Y);
         let b = b.moved(a.centre - b.centre + dir * (reach(&a) + reach(&b)) * rng.range(0.0, 0.9));
         let gap = true_gap(&a, &b);
-        let m = hull_hull(&a, &b, MARGIN);
-        let Some(m) = m else {
-            if gap < -TOL {
-                faults.push(format!("pair {k}: overlap {gap} but no contact"));
-            }
-            continue;
-        };
-        touching += 1;
-        if gap > MARGIN + TOL {
-            faults.push(format!("pair {k}: {gap} apart but {} points", m.points.len()));
-        }
-        if m.points.is_empty() || m.points.len() > 4 || (m.normal.length() - 1.0).abs() > 1e-4 {
-            faults.push(format!("pair {k}: {} points, normal {:?}", m.points.len(), m.normal));
-        }
-        for p in &m.points {
-            let sep = p.separation(m.normal);
-            if sep < gap.min(0.0) - EDGE_BIAS - TOL {
-                faults.push(format!("pair {k}: a point {sep} deep where the overlap is {gap}"));
-            }
-            let (off_a, off_b) = (to_polytope(p.on_a, &a), to_polytope(p.on_b, &b));
-            if off_a > TOL || off_b > TOL {
-                faults.push(format!("pair {k}: a point off its polytope by {off_a} / {off_b}"));
-            }
-        }
+        let off = |p: &ContactPoint| (to_polytope(p.on_a, &a), to_polytope(p.on_b, &b));
+        touching += usize::from(check_manifold(k, gap, hull_hull(&a, &b, MARGIN), 4, off, &mut faults));
     }
     assert!(faults.is_empty(), "{} faults: {:?}", faults.len(), &faults[..faults.len().min(10)]);
     assert!(touching > 1500, "too few touching pairs: {touching}");
@@ -237,29 +215,8 @@ fn hulls_and_round_shapes_keep_to_the_true_gap() {
         let at = a.centre + dir * (reach + 0.5) * rng.range(0.0, 1.2);
         let s = random_round(&mut rng, k, at);
         let gap = true_round_gap(&a, &s);
-        let Some(m) = hull_round(&a, &s, MARGIN) else {
-            if gap < -TOL {
-                faults.push(format!("pair {k}: overlap {gap} but no contact"));
-            }
-            continue;
-        };
-        touching += 1;
-        if gap > MARGIN + TOL {
-            faults.push(format!("pair {k}: {gap} apart but {} points", m.points.len()));
-        }
-        if m.points.is_empty() || m.points.len() > 2 || (m.normal.length() - 1.0).abs() > 1e-4 {
-            faults.push(format!("pair {k}: {} points, normal {:?}", m.points.len(), m.normal));
-        }
-        for p in &m.points {
-            let sep = p.separation(m.normal);
-            if sep < gap.min(0.0) - EDGE_BIAS - TOL {
-                faults.push(format!("pair {k}: a point {sep} deep where the overlap is {gap}"));
-            }
-            let (off_a, off_b) = (to_polytope(p.on_a, &a), to_core(p.on_b, &s) - s.radius);
-            if off_a > TOL || off_b > TOL {
-                faults.push(format!("pair {k}: a point off its shape by {off_a} / {off_b}"));
-            }
-        }
+        let off = |p: &ContactPoint| (to_polytope(p.on_a, &a), to_core(p.on_b, &s) - s.radius);
+        touching += usize::from(check_manifold(k, gap, hull_round(&a, &s, MARGIN), 2, off, &mut faults));
     }
     assert!(faults.is_empty(), "{} faults: {:?}", faults.len(), &faults[..faults.len().min(10)]);
     assert!(touching > 1200, "too few touching pairs: {touching}");
@@ -287,4 +244,41 @@ fn a_hull_meets_the_ground_at_its_lowest_corners() {
             assert!((p.on_b.y - ground).abs() < 1e-6 && (p.on_b - p.on_a).with_y(0.0).length() < 1e-6);
         }
     }
+}
+
+/// Checks pair `k`'s manifold `m` against the shapes' true gap: a contact
+/// wherever they overlap, none beyond the margin, 1 to `most` points under a
+/// unit normal, none deeper than the overlap, each on its shape (`off`: how
+/// far each end lies outside its shape). Whether the pair touched.
+fn check_manifold(
+    k: usize,
+    gap: f32,
+    m: Option<Manifold>,
+    most: usize,
+    off: impl Fn(&ContactPoint) -> (f32, f32),
+    faults: &mut Vec<String>,
+) -> bool {
+    let Some(m) = m else {
+        if gap < -TOL {
+            faults.push(format!("pair {k}: overlap {gap} but no contact"));
+        }
+        return false;
+    };
+    if gap > MARGIN + TOL {
+        faults.push(format!("pair {k}: {gap} apart but {} points", m.points.len()));
+    }
+    if m.points.is_empty() || m.points.len() > most || (m.normal.length() - 1.0).abs() > 1e-4 {
+        faults.push(format!("pair {k}: {} points, normal {:?}", m.points.len(), m.normal));
+    }
+    for p in &m.points {
+        let sep = p.separation(m.normal);
+        if sep < gap.min(0.0) - EDGE_BIAS - TOL {
+            faults.push(format!("pair {k}: a point {sep} deep where the overlap is {gap}"));
+        }
+        let (off_a, off_b) = off(p);
+        if off_a > TOL || off_b > TOL {
+            faults.push(format!("pair {k}: a point off its shape by {off_a} / {off_b}"));
+        }
+    }
+    true
 }
