@@ -157,6 +157,12 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     } else if (select(false, resting, params.sleep_after > 0.0)) {
         rest = s.rest_time + dt;
+    } else if (params.sleep_after > 0.0 && free && (s.pos_low & HELD) != 0u && !jointed && point_speed(s, p) < WAKE_SPEED) {
+        // jitter in place (faster than SLEEP_SPEED now and then, never as fast
+        // as what wakes) takes back its time instead of all the rest time, so
+        // a body slow more often than not still comes to sleep; not a jointed
+        // body, whose island sleeps as one
+        rest = max(s.rest_time - dt, 0.0);
     }
     if (rest >= params.sleep_after && rest > 0.0) {
         // asleep: held still where it is (resting on what pressed it)
