@@ -150,18 +150,21 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let jointed = joint_start[i] != joint_start[i + 1u];
     // a kinematic body keeps its velocities: no gravity or damping, no sleep
     let free = !is_kinematic(p);
-    let resting = ((s.pos_low & HELD) != 0u || jointed) && point_speed(s, p) < SLEEP_SPEED && free;
+    let held = ((s.pos_low & HELD) != 0u || jointed) && free;
+    let speed = point_speed(s, p);
+    let resting = held && speed < SLEEP_SPEED;
+    // jitter in place (faster than SLEEP_SPEED now and then, never as fast as
+    // what wakes) takes back its time instead of all the rest time, so a body
+    // slow more often than not still comes to sleep; not a jointed body, whose
+    // island sleeps as one
+    let jittering = held && !jointed && speed < WAKE_SPEED;
     if (asleep(s)) {
         if (!wake) {
             rest = s.rest_time;
         }
     } else if (select(false, resting, params.sleep_after > 0.0)) {
         rest = s.rest_time + dt;
-    } else if (params.sleep_after > 0.0 && free && (s.pos_low & HELD) != 0u && !jointed && point_speed(s, p) < WAKE_SPEED) {
-        // jitter in place (faster than SLEEP_SPEED now and then, never as fast
-        // as what wakes) takes back its time instead of all the rest time, so
-        // a body slow more often than not still comes to sleep; not a jointed
-        // body, whose island sleeps as one
+    } else if (select(false, jittering, params.sleep_after > 0.0)) {
         rest = max(s.rest_time - dt, 0.0);
     }
     if (rest >= params.sleep_after && rest > 0.0) {
