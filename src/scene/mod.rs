@@ -116,7 +116,9 @@ pub struct Settings {
     pub substeps: u32,
     /// Whether bodies at rest sleep (extension to the contract), default
     /// true: a body slower than 5 cm/s at every point for `SLEEP_AFTER`
-    /// seconds while touching something is held still until an awake body
+    /// seconds while touching something (faster moments below 20 cm/s, off
+    /// a joint, take that time back rather than all of it: jitter in place
+    /// does not keep a body awake) is held still until an awake body
     /// touching it moves faster than 20 cm/s or lies more than 1 cm inside
     /// it, or any input or edit wakes all. The paper has no sleeping and
     /// lists that as a weakness.
