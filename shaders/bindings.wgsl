@@ -416,15 +416,15 @@ fn poly_edge(h: Poly, e: u32) -> vec4<u32> {
     return bitcast<vec4<u32>>(hulls[h.first + 1u + h.corners + 2u * h.faces + h.index_words + e]);
 }
 
-// world_extent, for every shape: a hull's from its corners, about
-// `bound_offset`.
+// world_extent, for every shape: a hull's from its corners, about the
+// centre `bound_sphere` gives.
 fn body_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     if (p.shape != SHAPE_HULL) {
         return world_extent(s, p);
     }
     let h = poly_of(p);
     let r = quat_to_mat(s.rot);
-    let c = bound_offset(p);
+    let c = bound_sphere(p).xyz;
     var extent = vec3<f32>(0.0);
     for (var k = 0u; k < h.corners; k = k + 1u) {
         extent = max(extent, abs(r * (poly_corner(h, k) - c)));
@@ -432,29 +432,21 @@ fn body_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
     return extent;
 }
 
-// Where a body's broadphase bounds (pair_meta's extent and bound) are
-// centred, in its frame: its origin, but for a hull kept out of the grid
-// the centre of its corners' box (a drum panel's frame is the drum's axis;
-// bounds about it held every body in the drum).
-fn bound_offset(p: BodyProps) -> vec3<f32> {
+// The sphere a body's broadphase bounds (pair_meta's extent and bound) are
+// centred on, in its frame (xyz) and its radius (w): about its origin, but
+// for a hull kept out of the grid about its corners' box (a drum panel's
+// frame is the drum's axis; bounds about it held every body in the drum).
+fn bound_sphere(p: BodyProps) -> vec4<f32> {
     if (p.shape == SHAPE_HULL && p.grid_class == LARGE_BODY) {
-        return poly_sphere(poly_of(p)).xyz;
+        return poly_sphere(poly_of(p));
     }
-    return vec3<f32>(0.0);
+    return vec4<f32>(0.0, 0.0, 0.0, p.half_extents.w);
 }
 
-// The bounding radius about bound_offset.
-fn bound_radius(p: BodyProps) -> f32 {
-    if (p.shape == SHAPE_HULL && p.grid_class == LARGE_BODY) {
-        return poly_sphere(poly_of(p)).w;
-    }
-    return p.half_extents.w;
-}
-
-// The world centre of a body kept out of the grid's bounds (bound_offset).
+// The world centre of a body kept out of the grid's bounds (bound_sphere).
 fn large_centre(j: u32) -> vec3<f32> {
     let s = state_of(j);
-    return s.pos + quat_rotate(s.rot, bound_offset(props_of(j)));
+    return s.pos + quat_rotate(s.rot, bound_sphere(props_of(j)).xyz);
 }
 
 // reach_along, for every shape: a hull's farthest corner along dir.

@@ -116,7 +116,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     pair_meta[i].spin = spin;
     pair_meta[i].extent = body_extent(s, p) + vec3<f32>(reach + spin);
     // the bounding sphere turns into itself: only the centre's move grows it
-    pair_meta[i].bound = bound_radius(p) + reach;
+    pair_meta[i].bound = bound_sphere(p).w + reach;
     if (!grid_body(p)) {
         return;
     }
