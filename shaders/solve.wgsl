@@ -16,7 +16,8 @@ struct Snap {
 // Each point's normal snap closes its depth, shared by the inverse masses;
 // static friction (XPBD) undoes a slide shorter than mu times the summed push.
 // The points of one face each ask the whole depth, so their sum is scaled down
-// to what moving the bodies apart without turning asks, and their turns averaged.
+// to what moving the bodies apart without turning asks, and their turns by
+// how far the points' turns, summed, overshoot a shared turn (`turn_scale`).
 
 // Softened shock propagation (after Guendelman et al. 2003): in a contact
 // within 25 degrees of the vertical (|cos| > SHOCK_UP) the lower body counts
@@ -51,6 +52,26 @@ fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
         splits = vec2<f32>(friction_split(i, params.relaxation), pair_meta[i].normal_split);
     }
     return splits;
+}
+
+// Each point's snap turns its ends as if it alone asked: summed, a face's
+// points turn a box back past its tilt (four corners about 1.5 times), and
+// their mean (a quarter of the sum) leaves most of it, so a box under a load
+// off its middle stays tilted and, in a pyramid, its corner pushes its
+// neighbour aside. For a point's ask along d at offset r (w: the pair's
+// inverse mass along d there), end e's turn per unit ask, in each world axis,
+// is I^-1 (r x d) (r x d) / w; summed over the points that snapped (the
+// diagonal of their operator K), its largest component is how far their
+// summed turns overshoot a shared one.
+fn turn_share(e: ContactEnd, r: vec3<f32>, d: vec3<f32>, w: f32) -> vec3<f32> {
+    let rd = cross(r, d);
+    return select(vec3<f32>(0.0), (e.inv_i_world * rd) * rd / w, e.moves);
+}
+
+// The share of an end's summed turns it takes: the sum scaled back to one
+// turn, never up (a single point's is taken whole).
+fn turn_scale(k: vec3<f32>) -> f32 {
+    return 1.0 / max(1.0, max(k.x, max(k.y, k.z)));
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -97,6 +118,9 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     var points = 0u;
     var rubbed = 0u;
     var pressed = 0u;
+    // each end's turn per unit of its points' asks, summed over them (turn_scale)
+    var k_a = vec3<f32>(0.0);
+    var k_b = vec3<f32>(0.0);
         // depths summed: old overlap that settles, old overlap that supports, all
     var old_depth = 0.0;
     var shallow_depth = 0.0;
@@ -136,6 +160,8 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
             moment_a = moment_a + cross(ra, j);
             moment_b = moment_b + cross(rb, j);
             normal_inv_w = normal_inv_w + 1.0 / w;
+            k_a = k_a + turn_share(ea, ra, n, w);
+            k_b = k_b + turn_share(eb, rb, n, w);
             push = depth * params.relaxation;
             snapped = true;
         }
@@ -152,6 +178,8 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
                 moment_a = moment_a + cross(ra, j);
                 moment_b = moment_b + cross(rb, j);
                 friction_inv_w = friction_inv_w + 1.0 / w;
+                k_a = k_a + turn_share(ea, ra, t, w);
+                k_b = k_b + turn_share(eb, rb, t, w);
                 rubbed = rubbed + 1u;
                 snapped = true;
             }
@@ -181,7 +209,11 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         f_scale = min(f_scale, 1.0 / f32(max(rubbed, 1u)));
     }
     let j = normal_j * n_scale + friction_j * f_scale;
-    let turns = 1.0 / f32(max(points, 1u));
+    // a capsule's points lie along the axis it turns freely about, so they
+    // share one turn, their mean (docs/decisions/contacts.md)
+    let capsule = ea.half_height > 0.0 || eb.half_height > 0.0;
+    let turns_a = select(turn_scale(k_a), 1.0 / f32(max(points, 1u)), capsule);
+    let turns_b = select(turn_scale(k_b), 1.0 / f32(max(points, 1u)), capsule);
     let touched = u32(points > 0u);
     // the shares of the snap that settle and that support (see solve)
     let settle = u32(round(clamp(old_depth / max(all_depth, 1e-30), 0.0, 1.0) * SETTLE_ONE));
@@ -189,8 +221,8 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let flags = select(0u, SNAP_PRESSED, pressed != 0u) | (settle << SETTLE_SHIFT) | (support << SUPPORT_SHIFT);
     let against_a = select(0u, SNAP_FIXED_PARTNER, eb.fixed);
     let against_b = select(0u, SNAP_FIXED_PARTNER, ea.fixed);
-    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns, touched | against_a, flags));
-    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns, touched | against_b, flags));
+    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, touched | against_a, flags));
+    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, touched | against_b, flags));
 }
 
 @compute @workgroup_size(WORKGROUP)
@@ -242,8 +274,9 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         fixed_partners = fixed_partners || (snap.count & SNAP_FIXED_PARTNER) != 0u;
         flags = flags | snap.flags;
     }
-    // summed turns overshoot, so a partner's points share one turn and the
-    // partners' turns are averaged (translations are scaled per partner)
+    // summed turns overshoot, so each partner's turn is scaled back to one
+    // (turn_scale) and the partners' turns are averaged (translations are
+    // scaled per partner)
     let split = 1.0 / f32(max(touching, 1u));
     // a snap moves the displacement with the pose: the velocity changes by
     // dx / h, as Verlet's moving x_n while x_(n-1) stays does
