@@ -60,12 +60,17 @@ fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
 // off its middle stays tilted and, in a pyramid, its corner pushes its
 // neighbour aside. For a point's ask along d at offset r (w: the pair's
 // inverse mass along d there), end e's turn per unit ask, in each world axis,
-// is I^-1 (r x d) (r x d) / w; summed over the points that snapped (the
-// diagonal of their operator K), its largest component is how far their
-// summed turns overshoot a shared one.
-fn turn_share(e: ContactEnd, r: vec3<f32>, d: vec3<f32>, w: f32) -> vec3<f32> {
+// is I^-1 (r x d) (r x d) / w (end_turn / w); summed over the points that
+// snapped (the diagonal of their operator K), its largest component is how far
+// their summed turns overshoot a shared one.
+fn end_turn(e: ContactEnd, r: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let rd = cross(r, d);
-    return select(vec3<f32>(0.0), (e.inv_i_world * rd) * rd / w, e.moves);
+    return select(vec3<f32>(0.0), (e.inv_i_world * rd) * rd, e.moves);
+}
+
+// An end's inverse mass along d at r (end_inv_mass), from its end_turn.
+fn row_inv_mass(e: ContactEnd, turn: vec3<f32>) -> f32 {
+    return select(0.0, e.inv_inertia.w + turn.x + turn.y + turn.z, e.moves);
 }
 
 // The share of an end's summed turns it takes: the sum scaled back to one
@@ -154,14 +159,16 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         var push = 0.0;
         var snapped = false;
         if (depth > 0.0) {
-            let w = end_inv_mass(ea, ra, n) * split_a.y + end_inv_mass(eb, rb, n) * split_b.y;
+            let turn_a = end_turn(ea, ra, n);
+            let turn_b = end_turn(eb, rb, n);
+            let w = row_inv_mass(ea, turn_a) * split_a.y + row_inv_mass(eb, turn_b) * split_b.y;
             let j = n * (depth / w); // pushes b along n, a along -n
             normal_j = normal_j + j;
             moment_a = moment_a + cross(ra, j);
             moment_b = moment_b + cross(rb, j);
             normal_inv_w = normal_inv_w + 1.0 / w;
-            k_a = k_a + turn_share(ea, ra, n, w);
-            k_b = k_b + turn_share(eb, rb, n, w);
+            k_a = k_a + turn_a / w;
+            k_b = k_b + turn_b / w;
             push = depth * params.relaxation;
             snapped = true;
         }
@@ -172,14 +179,16 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
             let slide = length(slip_t);
             if (slide > 1e-9 && slide <= mu * (pt.pushed + push)) {
                 let t = slip_t / slide;
-                let w = end_inv_mass(ea, ra, t) * split_a.x + end_inv_mass(eb, rb, t) * split_b.x;
+                let turn_a = end_turn(ea, ra, t);
+                let turn_b = end_turn(eb, rb, t);
+                let w = row_inv_mass(ea, turn_a) * split_a.x + row_inv_mass(eb, turn_b) * split_b.x;
                 let j = t * (slide / w); // pulls b along t, a back along -t
                 friction_j = friction_j + j;
                 moment_a = moment_a + cross(ra, j);
                 moment_b = moment_b + cross(rb, j);
                 friction_inv_w = friction_inv_w + 1.0 / w;
-                k_a = k_a + turn_share(ea, ra, t, w);
-                k_b = k_b + turn_share(eb, rb, t, w);
+                k_a = k_a + turn_a / w;
+                k_b = k_b + turn_b / w;
                 rubbed = rubbed + 1u;
                 snapped = true;
             }
