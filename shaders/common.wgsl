@@ -398,6 +398,31 @@ fn end_inv_mass(e: ContactEnd, r: vec3<f32>, dir: vec3<f32>) -> f32 {
     return e.inv_inertia.w + dot(rn, e.inv_i_world * rn);
 }
 
+// Each point's snap turns its ends as if it alone asked: summed, a face's
+// points turn a box back past its tilt (four corners about 1.5 times), and
+// their mean (a quarter of the sum) leaves most of it, so a box under a load
+// off its middle stays tilted and, in a pyramid, its corner pushes its
+// neighbour aside. For a point's ask along d at offset r (w: the pair's
+// inverse mass along d there), end e's turn per unit ask, in each world axis,
+// is I^-1 (r x d) (r x d) / w (end_turn / w); summed over the points that
+// snapped (the diagonal of their operator K), its largest component is how far
+// their summed turns overshoot a shared one.
+fn end_turn(e: ContactEnd, r: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
+    let rd = cross(r, d);
+    return select(vec3<f32>(0.0), (e.inv_i_world * rd) * rd, e.moves);
+}
+
+// An end's inverse mass along d at r (end_inv_mass), from its end_turn.
+fn row_inv_mass(e: ContactEnd, turn: vec3<f32>) -> f32 {
+    return select(0.0, e.inv_inertia.w + turn.x + turn.y + turn.z, e.moves);
+}
+
+// The share of an end's summed turns it takes: the sum scaled back to one
+// turn, never up (a single point's is taken whole).
+fn turn_scale(k: vec3<f32>) -> f32 {
+    return 1.0 / max(1.0, max(k.x, max(k.y, k.z)));
+}
+
 // What a summed impulse-like j (moments `moment` = sum of r x j) asks of an end:
 // inverse mass times j, world inverse inertia times the moment (nothing if it stays).
 fn end_snap(e: ContactEnd, j: vec3<f32>, moment: vec3<f32>, count: u32, flags: u32) -> EndSnap {

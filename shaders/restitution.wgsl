@@ -93,6 +93,9 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     var bounce_inv_w = 0.0;
     var acting = 0u;
     var rubbing = 0u;
+    // each end's turn per unit of the points' changes, summed (turn_scale)
+    var k_a = vec3<f32>(0.0);
+    var k_b = vec3<f32>(0.0);
     for (var q = 0u; q < count; q = q + 1u) {
         let pt = point_of(at, q);
         set_pushed(at, q, 0.0);
@@ -117,6 +120,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
             // push through the inverse mass along n); bounding the velocity
             // change instead gave a sliding ball 3.5 times too little friction
             let w_t = end_inv_mass(ea, ra, t) * split_a + end_inv_mass(eb, rb, t) * split_b;
+            k_a = k_a + end_turn(ea, ra, t) / w_t;
+            k_b = k_b + end_turn(eb, rb, t) / w_t;
             let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
             let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / w_t);
             impulse = impulse + t * j;
@@ -128,6 +133,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         let target_vn = -e * approach;
         if (approach < -threshold && vn < target_vn) {
             let w = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
+            k_a = k_a + end_turn(ea, ra, n) / w;
+            k_b = k_b + end_turn(eb, rb, n) / w;
             bounce = n * ((target_vn - vn) / w);
             bounce_inv_w = bounce_inv_w + 1.0 / w;
             acted = true;
@@ -163,8 +170,19 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     moment_a = moment_a + bounce_moment_a * bounce_scale;
     moment_b = moment_b + bounce_moment_b * bounce_scale;
     let flags = select(0u, SNAP_BOUNCE, bounce_inv_w > 0.0);
-    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a, acting, flags));
-    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b, acting, flags));
+    // Each end's summed turns are scaled back to one (turn_scale), and
+    // `restituted` averages its manifolds' turns, as the solve does. A capsule's
+    // points (along its free axis) and a jointed body's (its joints pull back
+    // against a stronger turn: ten capsule ragdolls kept a limb moving) keep
+    // the mean over the points instead.
+    let capsule = ea.half_height > 0.0 || eb.half_height > 0.0;
+    let jointed = (a != GROUND && is_jointed(a)) || (b != GROUND && is_jointed(b));
+    let mean = capsule || jointed;
+    let turns_a = select(turn_scale(k_a), 1.0, mean);
+    let turns_b = select(turn_scale(k_b), 1.0, mean);
+    let counted = select(min(acting, 1u), acting, mean);
+    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, counted, flags));
+    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, counted, flags));
 }
 
 // The body half: body i's state with what its manifolds ask applied (summed in
@@ -206,6 +224,8 @@ fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState
     }
     dv = dv * min(1.0, longest / max(length(dv), 1e-30));
     dv = dv + bounces;
+    // the turns averaged over the manifolds that acted (over their points
+    // for a capsule's or a jointed body's; restitution_contacts)
     dw = dw / f32(max(acting, 1u));
     if (any(dv != vec3<f32>(0.0)) || any(dw != vec3<f32>(0.0))) {
         let now = pose_velocity(s.disp, s.rot, s.prev_rot);

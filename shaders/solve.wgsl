@@ -54,31 +54,6 @@ fn stay_splits(i: u32, partner_moves: bool) -> vec2<f32> {
     return splits;
 }
 
-// Each point's snap turns its ends as if it alone asked: summed, a face's
-// points turn a box back past its tilt (four corners about 1.5 times), and
-// their mean (a quarter of the sum) leaves most of it, so a box under a load
-// off its middle stays tilted and, in a pyramid, its corner pushes its
-// neighbour aside. For a point's ask along d at offset r (w: the pair's
-// inverse mass along d there), end e's turn per unit ask, in each world axis,
-// is I^-1 (r x d) (r x d) / w (end_turn / w); summed over the points that
-// snapped (the diagonal of their operator K), its largest component is how far
-// their summed turns overshoot a shared one.
-fn end_turn(e: ContactEnd, r: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let rd = cross(r, d);
-    return select(vec3<f32>(0.0), (e.inv_i_world * rd) * rd, e.moves);
-}
-
-// An end's inverse mass along d at r (end_inv_mass), from its end_turn.
-fn row_inv_mass(e: ContactEnd, turn: vec3<f32>) -> f32 {
-    return select(0.0, e.inv_inertia.w + turn.x + turn.y + turn.z, e.moves);
-}
-
-// The share of an end's summed turns it takes: the sum scaled back to one
-// turn, never up (a single point's is taken whole).
-fn turn_scale(k: vec3<f32>) -> f32 {
-    return 1.0 / max(1.0, max(k.x, max(k.y, k.z)));
-}
-
 @compute @workgroup_size(WORKGROUP)
 fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let used = manifolds_used();

@@ -327,7 +327,9 @@ pub(crate) const TABLE: [StageInfo; 24] = {
         S {
             over: Over::Manifolds,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            reads: &[
+                Params, Props, StateIn, Vel0, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3, JointStart,
+            ],
             writes: SNAP_WRITES,
             ..S::row(Stage::RestitutionContacts, "restitution_contacts", RESTITUTION_PASS, Part::Restitution)
         },
