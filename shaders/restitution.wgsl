@@ -176,7 +176,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     // against a stronger turn: ten capsule ragdolls kept a limb moving) keep
     // the mean over the points instead.
     let capsule = ea.half_height > 0.0 || eb.half_height > 0.0;
-    let jointed = (a != GROUND && is_jointed(a)) || (b != GROUND && is_jointed(b));
+    let jointed = is_jointed(a) || (b != GROUND && is_jointed(b)); // a is never the ground
     let mean = capsule || jointed;
     let turns_a = select(turn_scale(k_a), 1.0, mean);
     let turns_b = select(turn_scale(k_b), 1.0, mean);

@@ -196,8 +196,9 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     // a capsule's points lie along the axis it turns freely about, so they
     // share one turn, their mean (docs/decisions/contacts.md)
     let capsule = ea.half_height > 0.0 || eb.half_height > 0.0;
-    let turns_a = select(turn_scale(k_a), 1.0 / f32(max(points, 1u)), capsule);
-    let turns_b = select(turn_scale(k_b), 1.0 / f32(max(points, 1u)), capsule);
+    let mean = 1.0 / f32(max(points, 1u));
+    let turns_a = select(turn_scale(k_a), mean, capsule);
+    let turns_b = select(turn_scale(k_b), mean, capsule);
     let touched = u32(points > 0u);
     // the shares of the snap that settle and that support (see solve)
     let settle = u32(round(clamp(old_depth / max(all_depth, 1e-30), 0.0, 1.0) * SETTLE_ONE));
