@@ -153,8 +153,11 @@ fn nearest_on_face(h: Poly, f: u32, n: vec3<f32>, x: vec3<f32>) -> vec3<f32> {
 // deepest (a hull on a face has more than four corners there, and which is
 // deepest changes as it settles: a choice by depth alone rocked it); the
 // farthest from that; the largest triangle; the largest area added on the
-// other side. As src/reference/collide.rs's reduce, the first of equals each
-// time. Their indices, distinct, in the order chosen, and how many.
+// other side. On the ground the corners that bear (within CONTACT_SLOP of the
+// ground, or of the deepest) come first at each choice: a corner only near,
+// chosen over one that bears, let a hull tip toward the one left out, for good. As src/reference/collide.rs's
+// reduce, the first of equals each time. Their indices, distinct, in the
+// order chosen, and how many.
 struct Chosen {
     at: vec4<u32>,
     count: u32,
@@ -169,6 +172,7 @@ fn reduce(p: ptr<function, array<vec3<f32>, MAX_CLIP>>, height: ptr<function, ar
         }
     }
     let deepest = (*height)[c0];
+    let bears = max(deepest, 0.0) + CONTACT_SLOP;
     var far = -1.0;
     for (var i = 0u; i < count; i = i + 1u) {
         let off = (*p)[i] - about;
@@ -181,34 +185,43 @@ fn reduce(p: ptr<function, array<vec3<f32>, MAX_CLIP>>, height: ptr<function, ar
     let p0 = (*p)[c0];
     var c1 = 0u;
     var best = -1.0;
+    var rank = false;
     for (var i = 0u; i < count; i = i + 1u) {
         let d = dot((*p)[i] - p0, (*p)[i] - p0);
-        if (d > best) {
+        let r = level && d > 0.0 && (*height)[i] <= bears;
+        if ((r && !rank) || (r == rank && d > best)) {
             best = d;
             c1 = i;
+            rank = r;
         }
     }
     let p1 = (*p)[c1];
     var c2 = 0u;
     best = -3.4e38;
+    rank = false;
     for (var i = 0u; i < count; i = i + 1u) {
         let area = abs(dot(cross(p1 - p0, (*p)[i] - p0), n));
-        if (area > best) {
+        let r = level && area > 0.0 && (*height)[i] <= bears;
+        if ((r && !rank) || (r == rank && area > best)) {
             best = area;
             c2 = i;
+            rank = r;
         }
     }
     let p2 = (*p)[c2];
     let side = sign_of(dot(cross(p1 - p0, p2 - p0), n));
     var c3 = c0;
     best = -3.4e38;
+    rank = false;
     for (var i = 0u; i < count; i = i + 1u) {
         let q = (*p)[i];
         let added = max(max(-side * dot(cross(p1 - p0, q - p0), n), -side * dot(cross(p2 - p1, q - p1), n)),
                         -side * dot(cross(p0 - p2, q - p2), n));
-        if (added > best) {
+        let r = level && added > 0.0 && (*height)[i] <= bears;
+        if ((r && !rank) || (r == rank && added > best)) {
             best = added;
             c3 = i;
+            rank = r;
         }
     }
     var out = Chosen(vec4<u32>(c0, 0u, 0u, 0u), 1u);

@@ -383,7 +383,10 @@ pub(crate) fn closest_on_edges(pa: Vec3, da: Vec3, la: f32, pb: Vec3, db: Vec3, 
 /// farthest from it of those within `CONTACT_SLOP` of the deepest: a hull
 /// resting on a face has more than four corners on the ground, and the
 /// deepest of them changes as it settles by less than a millimetre; a choice
-/// by depth alone rocked it.
+/// by depth alone rocked it. On the ground the corners that bear (within
+/// `CONTACT_SLOP` of the ground, or of the deepest) come first at every
+/// choice: a corner only near, chosen over one that bears, let a hull tip
+/// toward the one left out, for good.
 pub(crate) fn reduce(points: Vec<(Vec2, f32)>, about: Option<Vec2>) -> Vec<(Vec2, f32)> {
     // 1: deepest (the first of equals, as every choice here)
     let mut chosen = [0usize; 4];
@@ -392,8 +395,23 @@ pub(crate) fn reduce(points: Vec<(Vec2, f32)>, about: Option<Vec2>) -> Vec<(Vec2
             chosen[0] = i;
         }
     }
+    let deepest = points[chosen[0]].1;
+    let bears = deepest.max(0.0) + crate::limits::CONTACT_SLOP;
+    // whether point i, adding `score` (distance or area) to the choice, bears
+    let ranked = |i: usize, score: f32| about.is_some() && score > 0.0 && points[i].1 <= bears;
+    // the best of (rank, score), the first of equals
+    let pick = |score: &dyn Fn(Vec2) -> f32, init: f32, first: usize| {
+        let (mut at, mut best, mut rank) = (first, init, false);
+        for (i, p) in points.iter().enumerate() {
+            let s = score(p.0);
+            let r = ranked(i, s);
+            if (r && !rank) || (r == rank && s > best) {
+                (at, best, rank) = (i, s, r);
+            }
+        }
+        at
+    };
     if let Some(c) = about {
-        let deepest = points[chosen[0]].1;
         let mut best = -1.0;
         for (i, p) in points.iter().enumerate() {
             let d = (p.0 - c).length_squared();
@@ -405,38 +423,17 @@ pub(crate) fn reduce(points: Vec<(Vec2, f32)>, about: Option<Vec2>) -> Vec<(Vec2
     }
     // 2: farthest from it
     let p0 = points[chosen[0]].0;
-    let mut best = -1.0;
-    for (i, p) in points.iter().enumerate() {
-        let d = (p.0 - p0).length_squared();
-        if d > best {
-            best = d;
-            chosen[1] = i;
-        }
-    }
+    chosen[1] = pick(&|q| (q - p0).length_squared(), -1.0, 0);
     // 3: largest triangle; 4: largest area added on the other side
     let p1 = points[chosen[1]].0;
-    let mut best = f32::MIN;
-    for (i, p) in points.iter().enumerate() {
-        let area = (p1 - p0).perp_dot(p.0 - p0).abs();
-        if area > best {
-            best = area;
-            chosen[2] = i;
-        }
-    }
+    chosen[2] = pick(&|q| (p1 - p0).perp_dot(q - p0).abs(), f32::MIN, 0);
     let p2 = points[chosen[2]].0;
     let side = (p1 - p0).perp_dot(p2 - p0).signum();
-    let mut best = f32::MIN;
-    chosen[3] = chosen[0];
-    for (i, p) in points.iter().enumerate() {
-        let q = p.0;
-        // area added outside the triangle
-        let added =
-            [(p0, p1), (p1, p2), (p2, p0)].iter().map(|(e0, e1)| -side * (*e1 - *e0).perp_dot(q - *e0)).fold(f32::MIN, f32::max);
-        if added > best {
-            best = added;
-            chosen[3] = i;
-        }
-    }
+    // area added outside the triangle
+    let added = |q: Vec2| {
+        [(p0, p1), (p1, p2), (p2, p0)].iter().map(|(e0, e1)| -side * (*e1 - *e0).perp_dot(q - *e0)).fold(f32::MIN, f32::max)
+    };
+    chosen[3] = pick(&added, f32::MIN, chosen[0]);
     // distinct choices only, in the order chosen
     let mut out = Vec::with_capacity(4);
     for (c, &i) in chosen.iter().enumerate() {
