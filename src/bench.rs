@@ -212,7 +212,7 @@ impl CopyKernel {
                 encode(&mut enc, Some(timer.writes(k)));
             }
             timer.resolve(&mut enc);
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc.finish());
             Ok(timer.read_ms(gpu)?)
         } else {
             let mut out = Vec::with_capacity(passes);
@@ -221,7 +221,7 @@ impl CopyKernel {
                 let started = Instant::now();
                 let mut enc = gpu.device.create_command_encoder(&Default::default());
                 encode(&mut enc, None);
-                gpu.queue.submit([enc.finish()]);
+                gpu.submit(enc.finish());
                 gpu.wait()?;
                 out.push(started.elapsed().as_secs_f64() * 1e3);
             }

@@ -64,10 +64,11 @@ pub struct Gpu {
     /// Why the device was lost, once wgpu has said so (it calls the
     /// device-lost callback while polling).
     lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
-    /// Held while polling: wgpu-core 30.0.1 can panic when two threads poll
-    /// one device at once (an assertion in `Device::maintain` races; fixed
-    /// upstream in gfx-rs/wgpu#9958). Threads that share a `Gpu` (the tests
-    /// do) poll one at a time.
+    /// Held while polling and while submitting: wgpu-core 30.0 can panic
+    /// when one thread waits on a device while another polls or submits to
+    /// it (an assertion in `Device::maintain` races with a submission not yet
+    /// tracked; fixed upstream in gfx-rs/wgpu#9958). Threads that share a
+    /// `Gpu` (the tests do) take turns.
     polling: std::sync::Mutex<()>,
     /// Which `Gpu` of this process it is: wgpu's devices of two instances
     /// may compare equal (wgpu-core's ids are per instance).
@@ -326,6 +327,13 @@ impl Gpu {
         format!("{} ({:?}, {:?}, driver {} {})", i.name, i.backend, i.device_type, i.driver, i.driver_info)
     }
 
+    /// Submits `commands` to the queue, in turn with other threads' waits
+    /// (see `polling`).
+    pub fn submit(&self, commands: wgpu::CommandBuffer) {
+        let _one_at_a_time = self.polling.lock().unwrap_or_else(|e| e.into_inner());
+        self.queue.submit([commands]);
+    }
+
     /// Waits for all submitted work, at most `WAIT_LIMIT`; reports a lost
     /// device, a timeout, or any error the device raised.
     pub fn wait(&self) -> Result<(), GpuError> {
@@ -383,7 +391,7 @@ impl Gpu {
             enc.copy_buffer_to_buffer(src, 0, &staging, at, size);
             at += size;
         }
-        self.queue.submit([enc.finish()]);
+        self.submit(enc.finish());
         let (tx, rx) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
             let _ = tx.send(r);

@@ -501,7 +501,7 @@ impl Canvas {
             },
             wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
         );
-        self.queue.submit([enc.finish()]);
+        gpu.submit(enc.finish());
 
         let (tx, rx) = std::sync::mpsc::channel();
         self.data.readback.map_async(wgpu::MapMode::Read, .., move |r| {

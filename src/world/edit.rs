@@ -121,7 +121,7 @@ impl World {
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("edit") });
         // no body has woken another yet (`PairMeta::woken`), and no contacts
         encoder.clear_buffer(&data.pair_meta, 0, None);
-        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.submit(encoder.finish());
         data.bind_groups = Some(data.step_bind_groups(&self.gpu.device, &self.pipelines));
         self.gpu.check()?;
 

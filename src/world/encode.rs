@@ -109,7 +109,7 @@ impl World {
         for first in (0..slot).step_by(substeps * self.slots_per_substep()) {
             self.encode_step(&mut encoder, &plan, first);
         }
-        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.submit(encoder.finish());
         self.finish_steps(dts, substeps);
     }
 
@@ -257,7 +257,7 @@ impl World {
         for &stage in stages {
             self.encode_pass(&mut encoder, stage, 0, None);
         }
-        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.submit(encoder.finish());
         Ok(self.gpu.wait()?)
     }
 

@@ -618,7 +618,7 @@ impl World {
             pass.set_pipeline(&input.pipelines[WAKE_ALL]);
             pass.dispatch_workgroups(self.body_count.div_ceil(WORKGROUP).max(1), 1, 1);
         }
-        gpu.queue.submit([encoder.finish()]);
+        gpu.submit(encoder.finish());
         gpu.check()?;
         Ok(())
     }

@@ -310,7 +310,7 @@ impl World {
             encoder.copy_buffer_to_buffer(state, 0, to, 0, state.size());
         }
         encoder.copy_buffer_to_buffer(status, 0, &self.data.status, 0, Status::BYTES);
-        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.submit(encoder.finish());
     }
 
     /// Counts `steps` steps of `dt` of a world at rest (`at_rest`): what

@@ -148,7 +148,7 @@ impl World {
                 remake(buffer, "manifolds/snaps", size);
             }
         }
-        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.submit(encoder.finish());
         if pool_in_parts(&self.gpu, manifolds) && !self.pipelines.pool_split {
             // once, for the largest scenes: the passes read and write the parts
             self.pipelines.split_pool(&self.gpu);

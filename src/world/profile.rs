@@ -39,12 +39,12 @@ impl World {
                 match &timer {
                     Some(timer) => self.encode_pass(&mut encoder, stage, slot, Some(timer.writes(k))),
                     None => {
-                        gpu.queue.submit([encoder.finish()]);
+                        gpu.submit(encoder.finish());
                         gpu.wait()?;
                         let started = std::time::Instant::now();
                         encoder = gpu.device.create_command_encoder(&Default::default());
                         self.encode_pass(&mut encoder, stage, slot, None);
-                        gpu.queue.submit([encoder.finish()]);
+                        gpu.submit(encoder.finish());
                         gpu.wait()?;
                         totals[stage as usize] += started.elapsed().as_secs_f64() * 1e3;
                         encoder = gpu.device.create_command_encoder(&Default::default());
@@ -54,7 +54,7 @@ impl World {
             if let Some(timer) = &timer {
                 timer.resolve(&mut encoder);
             }
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit(encoder.finish());
             if let Some(timer) = &timer {
                 for ((stage, _), ms) in plan.iter().zip(timer.read_ms(&gpu)?) {
                     totals[*stage as usize] += ms;
