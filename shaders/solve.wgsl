@@ -492,7 +492,7 @@ fn unwritten(i: u32, held: vec2<u32>, moved: vec2<bool>) -> bool {
     return (held[0] == i && moved[0]) || (held[1] == i && moved[1]);
 }
 
-@compute @workgroup_size(WORKGROUP)
+@compute @workgroup_size(PATH_WORKGROUP)
 fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     let path = params.path_first + gid.x;
     if (path >= params.path_end) {

@@ -39,6 +39,7 @@ pub fn shared_constants() -> String {
         ("GRID_BODY", GRID_BODY),
         ("LARGE_BODY", LARGE_BODY),
         ("WORKGROUP", WORKGROUP),
+        ("PATH_WORKGROUP", PATH_WORKGROUP),
         ("SCAN_BLOCK", SCAN_BLOCK),
         ("SCAN_RUN", SCAN_RUN),
         ("SCAN_SPAN", SCAN_SPAN),

@@ -322,6 +322,12 @@ pub const LARGE_BODY: u32 = 1;
 /// Threads per workgroup of every per-body pass (`WORKGROUP` in WGSL).
 pub const WORKGROUP: u32 = 64;
 
+/// Threads per workgroup of `solve_joints`, one a joint path: a colour may
+/// have a few paths only, each a long serial loop, and small workgroups
+/// spread them evenly over a software adapter's threads (`PATH_WORKGROUP`
+/// in WGSL).
+pub const PATH_WORKGROUP: u32 = 8;
+
 /// Byte stride between the per-step `Params` slots of a batch: the
 /// uniform-buffer offset alignment WebGPU guarantees to work everywhere.
 pub(crate) const PARAMS_STRIDE: u64 = 256;

@@ -271,7 +271,7 @@ impl World {
             Over::One => 1,
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
             Over::IslandJoints => self.island_joints.div_ceil(WORKGROUP),
-            Over::Paths => self.path_colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0).div_ceil(WORKGROUP),
+            Over::Paths => self.path_colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0).div_ceil(PATH_WORKGROUP),
             Over::Pairs | Over::Manifolds | Over::Listed => unreachable!("dispatched indirectly"),
         };
         n.max(1)
