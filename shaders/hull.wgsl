@@ -155,9 +155,9 @@ fn nearest_on_face(h: Poly, f: u32, n: vec3<f32>, x: vec3<f32>) -> vec3<f32> {
 // farthest from that; the largest triangle; the largest area added on the
 // other side. On the ground the corners that bear (within CONTACT_SLOP of the
 // ground, or of the deepest) come first at each choice: a corner only near,
-// chosen over one that bears, let a hull tip toward the one left out, for good. As src/reference/collide.rs's
-// reduce, the first of equals each time. Their indices, distinct, in the
-// order chosen, and how many.
+// chosen over one that bears, let a hull tip toward the one left out, for
+// good. As src/reference/collide.rs's reduce, the first of equals each time.
+// Their indices, distinct, in the order chosen, and how many.
 struct Chosen {
     at: vec4<u32>,
     count: u32,
