@@ -105,6 +105,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         if (dot((eb.pos + rb) - (ea.pos + ra), n) > CONTACT_SLOP) {
             continue;
         }
+        // the pair's inverse mass along n at the point (friction's bound, the bounce)
+        let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
         // a's point's velocity relative to b's after the solve; the approach before it
         let relative_now = point_velocity(va, ra) - point_velocity(vb, rb);
         let approach = -dot(point_velocity(va0, ra) - point_velocity(vb0, rb), n);
@@ -122,7 +124,6 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
             let w_t = end_inv_mass(ea, ra, t) * split_a + end_inv_mass(eb, rb, t) * split_b;
             k_a = k_a + end_turn(ea, ra, t) / w_t;
             k_b = k_b + end_turn(eb, rb, t) / w_t;
-            let w_n = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
             let j = min(mu * pt.pushed / params.dt / max(w_n, 1e-30), sliding / w_t);
             impulse = impulse + t * j;
             rubbing = rubbing + 1u;
@@ -132,11 +133,10 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         let vn = -dot(relative_now, n);
         let target_vn = -e * approach;
         if (approach < -threshold && vn < target_vn) {
-            let w = end_inv_mass(ea, ra, n) + end_inv_mass(eb, rb, n);
-            k_a = k_a + end_turn(ea, ra, n) / w;
-            k_b = k_b + end_turn(eb, rb, n) / w;
-            bounce = n * ((target_vn - vn) / w);
-            bounce_inv_w = bounce_inv_w + 1.0 / w;
+            k_a = k_a + end_turn(ea, ra, n) / w_n;
+            k_b = k_b + end_turn(eb, rb, n) / w_n;
+            bounce = n * ((target_vn - vn) / w_n);
+            bounce_inv_w = bounce_inv_w + 1.0 / w_n;
             acted = true;
         }
         if (acted) {

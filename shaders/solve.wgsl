@@ -101,7 +101,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     // each end's turn per unit of its points' asks, summed over them (turn_scale)
     var k_a = vec3<f32>(0.0);
     var k_b = vec3<f32>(0.0);
-        // depths summed: old overlap that settles, old overlap that supports, all
+    // depths summed: old overlap that settles, old overlap that supports, all
     var old_depth = 0.0;
     var shallow_depth = 0.0;
     var all_depth = 0.0;
