@@ -199,7 +199,10 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rot = normalize(quat_mul(turn, s.rot));
     let spin = quat_to_rotvec(turn);
 
-    set_state(i, BodyState(pos, rest, disp, pack_remainder(dropped, pos, (s.pos_low & HELD) | wakes), rot, s.rot));
+    // HELD (a contact pushed it) stays for solve to renew; solve passes over
+    // a body with no contacts, so it is cleared here
+    let pressed = select(0u, s.pos_low & HELD, pair_meta[i].contacts != 0u);
+    set_state(i, BodyState(pos, rest, disp, pack_remainder(dropped, pos, pressed | wakes), rot, s.rot));
     vel0[i] = Velocity(vec4<f32>(disp / dt, 0.0), vec4<f32>(spin / dt, 0.0));
     moved();
 }

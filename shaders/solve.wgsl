@@ -3,8 +3,10 @@
 // (eqs. 9-10). Contacts are relaxed Jacobi style from state_in: solve_contacts
 // (per manifold) writes what a pair's points ask of each body (two EndSnaps),
 // and solve (per listed body) sums them in pair order, relaxes the sum by c_r
-// and writes its own slot of state_out. All of a body's snaps are measured on
-// one pose, so symmetric contacts cancel and no sum depends on thread timing.
+// and moves its own pose in place (bound as state_out: every snap was measured
+// in the pass before), passing over a body with no contacts. All of a body's
+// snaps are measured on one pose, so symmetric contacts cancel and no sum
+// depends on thread timing.
 // The reasons behind the constants: docs/decisions/contacts.md, joints.md.
 
 // A snap being summed: translation and rotation (radians, world axes).
@@ -216,10 +218,13 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    var s = state_of(i);
+    // nothing to sum: the pose stays as integrate wrote it (which cleared HELD)
+    if (pair_meta[i].contacts == 0u) {
+        return;
+    }
+    var s = out_state(i);
     let p = props_of(i);
     if (is_fixed(p) || is_kinematic(p) || asleep(s)) {
-        set_state(i, s);
         return;
     }
     var acc = Snap(vec3<f32>(0.0), vec3<f32>(0.0));
@@ -330,7 +335,7 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
     let other = select(m.b, m.a, is_b);
     // n from this body toward its partner
     let n = select(m.normal, -m.normal, is_b);
-    let o = state_of(other);
+    let o = out_state(other);
     let overlap = dot(s.pos - o.pos, n) + body_reach(p, s.rot, n) + body_reach(props_of(other), o.rot, -n);
     return -n * max(overlap - GROUND_DEPTH, 0.0);
 }

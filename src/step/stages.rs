@@ -287,9 +287,9 @@ pub(crate) const TABLE: [StageInfo; 24] = {
         },
         S {
             over: Over::Listed,
-            poses: Poses::Flip,
+            poses: Poses::InPlace,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds, Hulls],
+            reads: &[Params, Props, StateOut, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds, Hulls],
             writes: &[StateOut],
             ..S::row(Stage::Solve, "solve", SOLVE_PASS, Part::Solve)
         },

@@ -224,15 +224,15 @@ fn bad_files_are_refused_with_a_reason() {
     }
 }
 
-/// With one substep of three iterations a step flips the pose buffers five
-/// times, so after an odd number of steps the original world's current
-/// buffer is the other one than a fresh world's: only the current poses
-/// carry state.
+/// With two substeps a step flips the pose buffers three times (`integrate`
+/// in each, `restitution` after the last), so after an odd number of steps
+/// the original world's current buffer is the other one than a fresh
+/// world's: only the current poses carry state.
 #[test]
 fn restore_does_not_depend_on_which_buffer_is_current() {
     let Some(gpu) = crate::common::gpu() else { return };
     let mut scene = scenes::cubes(100, 2);
-    scene.settings.substeps = 1;
+    scene.settings.substeps = 2;
     scene.settings.iterations = 3;
     let mut a = World::with_gpu(gpu.clone(), &scene).unwrap();
     a.step(160).unwrap();
