@@ -154,6 +154,23 @@ fn list_body(i: u32) {
     }
 }
 
+// The body that invocation k of `solve` works on, or NONE: the k-th listed
+// body with contacts, in sorted[2 body_count ..] (status[STATUS_TOUCHING] of
+// them; filled with NONE as the listed run is). A body with no contacts has
+// nothing to sum, so `solve` costs a body in flight or hung on joints nothing.
+fn touching_body(k: u32) -> u32 {
+    return select(NONE, sorted[2u * params.body_count + k], k < params.body_count);
+}
+
+// Lists body i for `solve` (contact_lists, see `touching_body`), as list_body does.
+fn list_touching(i: u32) {
+    let k = atomicAdd(&status[STATUS_TOUCHING], 1u);
+    sorted[2u * params.body_count + k] = i;
+    if (k % WORKGROUP == 0u) {
+        atomicAdd(&status[STATUS_TOUCHING_DISPATCH], 1u);
+    }
+}
+
 // The k-th body kept out of the grid (its index).
 fn large_body(k: u32) -> u32 {
     return sorted[params.body_count - params.large_count + k];

@@ -99,6 +99,8 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         // contact_lists lists the bodies and counts their workgroups
         atomicStore(&status[STATUS_LISTED], 0u);
         atomicStore(&status[STATUS_LISTED_DISPATCH], 0u);
+        atomicStore(&status[STATUS_TOUCHING], 0u);
+        atomicStore(&status[STATUS_TOUCHING_DISPATCH], 0u);
     }
     if (i >= params.body_count) {
         return;

@@ -342,6 +342,9 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     // changes nothing: integrate holds it, the others copy it)
     if (!sleeps_held(i) || atomicLoad(&pair_meta[i].woken) != 0u || may_wake) {
         list_body(i);
+        if (end > first) {
+            list_touching(i);
+        }
     }
 }
 

@@ -214,7 +214,7 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
 
 @compute @workgroup_size(WORKGROUP)
 fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = listed_body(gid.x);
+    let i = touching_body(gid.x);
     if (i >= params.body_count) {
         return;
     }

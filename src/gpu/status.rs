@@ -10,7 +10,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::limits::NO_FAULT;
 
-/// The status words, in buffer order (88 bytes). The host reads it back
+/// The status words, in buffer order (104 bytes). The host reads it back
 /// after each batch of steps (`World::fit_pools`), and on request.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -47,6 +47,11 @@ pub struct Status {
     /// Their indirect dispatch (workgroups over them, 1, 1), counted by contact_lists and copied
     /// out after it.
     pub listed_dispatch: [u32; 3],
+    /// Of them, the bodies with contacts, which `solve` runs over (`touching_body`), listed by
+    /// contact_lists.
+    pub touching: u32,
+    /// Their indirect dispatch, counted and copied as `listed_dispatch` is.
+    pub touching_dispatch: [u32; 3],
     /// 1 once a pair walk took so many loop trips that the driver may have cut it short (LOOP_TRIPS); never cleared.
     pub walks_cut: u32,
     /// 1 once a contact list's sort may have been cut short alike (contact_lists); never cleared.
@@ -82,6 +87,8 @@ impl Status {
         moving: 0,
         listed: 0,
         listed_dispatch: [0, 1, 1],
+        touching: 0,
+        touching_dispatch: [0, 1, 1],
         walks_cut: 0,
         lists_cut: 0,
     };
@@ -89,7 +96,7 @@ impl Status {
     /// The WGSL name and the first word of every field, in order: the
     /// shared constants (`shaders::shared_constants`) by which WGSL indexes
     /// the status words.
-    pub const WORDS: [(&'static str, u32); 16] = [
+    pub const WORDS: [(&'static str, u32); 18] = [
         ("STATUS_PAIRS", word!(pairs)),
         ("STATUS_PAIRS_MAX", word!(pairs_max)),
         ("STATUS_FAULT", word!(fault)),
@@ -104,6 +111,8 @@ impl Status {
         ("STATUS_MOVING", word!(moving)),
         ("STATUS_LISTED", word!(listed)),
         ("STATUS_LISTED_DISPATCH", word!(listed_dispatch)),
+        ("STATUS_TOUCHING", word!(touching)),
+        ("STATUS_TOUCHING_DISPATCH", word!(touching_dispatch)),
         ("STATUS_WALKS_CUT", word!(walks_cut)),
         ("STATUS_LISTS_CUT", word!(lists_cut)),
     ];

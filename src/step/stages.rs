@@ -63,6 +63,9 @@ pub(crate) enum Over {
     /// indirect dispatch whose size `contact_lists` counted
     /// (`Status::listed_dispatch`).
     Listed,
+    /// Of those, the bodies with contacts (`touching_body`): sized alike
+    /// (`Status::touching_dispatch`).
+    Touching,
 }
 
 /// What a stage does with the pose buffers.
@@ -261,7 +264,7 @@ pub(crate) const TABLE: [StageInfo; 24] = {
             reads: &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
             writes: &[Sorted, Status, PairMeta, BodyPairs],
             // once, for every contact and body pass of the step's substeps
-            copy_after: &[Over::Manifolds, Over::Listed],
+            copy_after: &[Over::Manifolds, Over::Listed, Over::Touching],
             ..S::row(Stage::ContactLists, "contact_lists", NARROWPHASE_PASS, Narrowphase)
         },
         S {
@@ -286,7 +289,7 @@ pub(crate) const TABLE: [StageInfo; 24] = {
             ..S::row(Stage::SolveContacts, "solve_contacts", SOLVE_PASS, Part::Solve)
         },
         S {
-            over: Over::Listed,
+            over: Over::Touching,
             poses: Poses::InPlace,
             runs: Runs::InSubsteps,
             reads: &[Params, Props, StateOut, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds, Hulls],

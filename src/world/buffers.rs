@@ -78,6 +78,8 @@ pub(super) struct Dispatches {
     _pad1: u32,
     listed: [u32; 3],
     _pad2: u32,
+    touching: [u32; 3],
+    _pad3: u32,
 }
 
 /// Where an indirect dispatch over `over` takes its size: its place in the
@@ -88,6 +90,7 @@ pub(super) fn indirect(over: Over) -> Option<(u64, u64)> {
         Over::Pairs => (offset_of!(Dispatches, pairs), offset_of!(Status, pairs_dispatch)),
         Over::Manifolds => (offset_of!(Dispatches, manifolds), offset_of!(Status, manifolds_dispatch)),
         Over::Listed => (offset_of!(Dispatches, listed), offset_of!(Status, listed_dispatch)),
+        Over::Touching => (offset_of!(Dispatches, touching), offset_of!(Status, touching_dispatch)),
         _ => return None,
     };
     Some((slot as u64, words as u64))
@@ -228,7 +231,7 @@ impl WorldData {
     }
 
     /// `sorted`: the grid's order, then the bodies the step's body passes
-    /// run over.
+    /// run over, then those of them with contacts (`solve`'s).
     pub(crate) fn sorted(&self) -> &wgpu::Buffer {
         &self.scratch[4]
     }
@@ -349,7 +352,7 @@ impl BodyBuffers {
         // block totals of the grid's scan and the pairs' (xy)
         let block_sums = storage("scan/block_sums", 8 * hash.max(count).div_ceil(SCAN_SPAN as u64));
         // the grid's order, then the step's listed bodies (`listed_body` in bindings.wgsl)
-        let sorted = storage("grid/sorted", 8 * count);
+        let sorted = storage("grid/sorted", 12 * count);
         // the grid bodies' bounds in the grid's order (grid_sort, for the pair walks)
         let cell_bounds = storage("grid/cell_bounds", count * size_of::<CellBound>() as u64);
         BodyBuffers {

@@ -87,12 +87,12 @@ pub fn bytes_per_body() -> u64 {
 /// Bytes of GPU memory a body holds whatever it touches: poses (two
 /// buffers), properties, velocities, its pair bookkeeping, the grid's share
 /// (sorted list, its bounds in that order, about two hash buckets with
-/// their counts and starts), its place in the list of bodies the body
+/// their counts and starts), its places in the lists of bodies the body
 /// passes run over, and the copy of the pose a batch of steps starts from.
 pub fn body_bytes() -> u64 {
     let state = size_of::<BodyState>() as u64;
     let meta = size_of::<PairMeta>() as u64;
-    let grid = 2 * 4 + size_of::<CellBound>() as u64 + 2 * 8;
+    let grid = 3 * 4 + size_of::<CellBound>() as u64 + 2 * 8;
     3 * state + size_of::<BodyProps>() as u64 + size_of::<Velocity>() as u64 + meta + grid
 }
 

@@ -238,20 +238,26 @@ impl World {
         self.write_params(&[self.settings.dt], self.settings.substeps as usize);
         if !stages.contains(&Stage::ContactLists) {
             let clears = [Stage::GridScatter, Stage::PairsCount];
-            if stages.iter().any(|s| clears.contains(s)) && stages.iter().any(|s| s.over() == Over::Listed) {
+            let listed = |s: &Stage| matches!(s.over(), Over::Listed | Over::Touching);
+            if stages.iter().any(|s| clears.contains(s)) && stages.iter().any(listed) {
                 return Err(Error::Input(
                     "run_stages: grid_scatter and pairs_count overwrite the list of bodies that contact_lists makes".into(),
                 ));
             }
-            // no list made: the body passes run over every body
+            // no lists made: the body passes run over every body (solve passes
+            // over those with no contacts itself)
             let n = self.body_count;
             let every: Vec<u32> = (0..n).collect();
             let queue = &self.gpu.queue;
-            queue.write_buffer(self.data.sorted(), 4 * n as u64, bytemuck::cast_slice(&every));
-            queue.write_buffer(&self.data.status, offset_of!(Status, listed) as u64, bytemuck::bytes_of(&n));
-            let (slot, _) = indirect(Over::Listed).expect("dispatched indirectly");
             let all = [self.workgroups(Over::Bodies), 1, 1];
-            queue.write_buffer(&self.data.dispatch, slot, bytemuck::cast_slice(&all));
+            for (k, over, count) in
+                [(1, Over::Listed, offset_of!(Status, listed)), (2, Over::Touching, offset_of!(Status, touching))]
+            {
+                queue.write_buffer(self.data.sorted(), 4 * k * n as u64, bytemuck::cast_slice(&every));
+                queue.write_buffer(&self.data.status, count as u64, bytemuck::bytes_of(&n));
+                let (slot, _) = indirect(over).expect("dispatched indirectly");
+                queue.write_buffer(&self.data.dispatch, slot, bytemuck::cast_slice(&all));
+            }
         }
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stages") });
         for &stage in stages {
@@ -272,7 +278,7 @@ impl World {
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
             Over::IslandJoints => self.island_joints.div_ceil(WORKGROUP),
             Over::Paths => self.path_colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0).div_ceil(PATH_WORKGROUP),
-            Over::Pairs | Over::Manifolds | Over::Listed => unreachable!("dispatched indirectly"),
+            Over::Pairs | Over::Manifolds | Over::Listed | Over::Touching => unreachable!("dispatched indirectly"),
         };
         n.max(1)
     }

@@ -242,6 +242,8 @@ fn status_words_match_the_struct() {
         moving => "STATUS_MOVING",
         listed => "STATUS_LISTED",
         listed_dispatch => "STATUS_LISTED_DISPATCH",
+        touching => "STATUS_TOUCHING",
+        touching_dispatch => "STATUS_TOUCHING_DISPATCH",
         walks_cut => "STATUS_WALKS_CUT",
         lists_cut => "STATUS_LISTS_CUT",
     );
