@@ -237,6 +237,9 @@ fn restituted(i: u32, s_in: BodyState, p: BodyProps, pending: bool) -> BodyState
     return s;
 }
 
+// Over every listed body, into the other state buffer: a body that fell
+// asleep in the step's last substep then holds its pose in both, as a
+// sleeper the next step leaves out must (`listed_body`).
 @compute @workgroup_size(WORKGROUP)
 fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = listed_body(gid.x);
