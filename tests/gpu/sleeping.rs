@@ -400,8 +400,19 @@ fn the_body_passes_run_over_the_awake_bodies_and_leave_sleepers_alike_in_both_bu
         assert!(body.asleep, "body {i} is awake and was left out of the body passes");
         assert_eq!(a[i * words..(i + 1) * words], b[i * words..(i + 1) * words], "sleeper {i} differs between the state buffers");
     }
+    // solve's list: the listed bodies with contacts, each once
+    let touching = {
+        let count = w.read_status().unwrap().touching as usize;
+        w.read_words(Buffer::Sorted).unwrap()[2 * n..2 * n + count].to_vec()
+    };
+    let meta: Vec<verlet::gpu::types::PairMeta> = bytemuck::pod_collect_to_vec(&w.read_words(Buffer::PairMeta).unwrap());
+    let mut with_contacts: Vec<u32> = list.iter().copied().filter(|&i| meta[i as usize].contacts > 0).collect();
+    with_contacts.sort_unstable();
+    let mut solved = touching.clone();
+    solved.sort_unstable();
+    assert_eq!(solved, with_contacts, "solve's list is not the listed bodies with contacts, each once");
     let asleep = bodies.iter().filter(|b| b.asleep).count();
-    println!("after {steps} steps: {asleep} of {n} asleep, {} listed", list.len());
+    println!("after {steps} steps: {asleep} of {n} asleep, {} listed, {} with contacts", list.len(), touching.len());
     assert!(list.len() < n, "every body was listed in a pile half asleep");
     w.apply_impulse(0, [0.0, 100.0, 0.0], None).unwrap();
     w.step(1).unwrap();
