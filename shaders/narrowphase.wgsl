@@ -339,7 +339,8 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     pair_meta[i].normal_split = select(1.0, max(1.0, params.relaxation * (f32(held) + movers)), held > 0u && !jointed);
     // the bodies the step may change, for the body passes (`listed_body`): all
     // but the sleepers held still that nothing woke or may wake (listing one
-    // changes nothing: integrate holds it, the others copy it)
+    // changes nothing: integrate holds it, restitution copies it), and of
+    // them those with contacts for `solve`
     if (!sleeps_held(i) || atomicLoad(&pair_meta[i].woken) != 0u || may_wake) {
         list_body(i);
         if (end > first) {

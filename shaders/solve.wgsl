@@ -2,11 +2,10 @@
 // each substep its share of `iterations` times: the paper's corrective snaps
 // (eqs. 9-10). Contacts are relaxed Jacobi style from state_in: solve_contacts
 // (per manifold) writes what a pair's points ask of each body (two EndSnaps),
-// and solve (per listed body) sums them in pair order, relaxes the sum by c_r
-// and moves its own pose in place (bound as state_out: every snap was measured
-// in the pass before), passing over a body with no contacts. All of a body's
-// snaps are measured on one pose, so symmetric contacts cancel and no sum
-// depends on thread timing.
+// and solve (per listed body with contacts) sums them in pair order, relaxes
+// the sum by c_r and moves its own pose in place (bound as state_out: every
+// snap was measured in the pass before). All of a body's snaps are measured on
+// one pose, so symmetric contacts cancel and no sum depends on thread timing.
 // The reasons behind the constants: docs/decisions/contacts.md, joints.md.
 
 // A snap being summed: translation and rotation (radians, world axes).
@@ -218,7 +217,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.body_count) {
         return;
     }
-    // nothing to sum: the pose stays as integrate wrote it (which cleared HELD)
+    // nothing to sum (run_stages lists every body): the pose stays as
+    // integrate wrote it, which cleared HELD
     if (pair_meta[i].contacts == 0u) {
         return;
     }

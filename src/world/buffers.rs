@@ -351,7 +351,8 @@ impl BodyBuffers {
         let cell_start = storage("grid/cell_start", 4 * (hash + 1));
         // block totals of the grid's scan and the pairs' (xy)
         let block_sums = storage("scan/block_sums", 8 * hash.max(count).div_ceil(SCAN_SPAN as u64));
-        // the grid's order, then the step's listed bodies (`listed_body` in bindings.wgsl)
+        // the grid's order, then the step's listed bodies and those of them with
+        // contacts (`listed_body`, `touching_body` in bindings.wgsl)
         let sorted = storage("grid/sorted", 12 * count);
         // the grid bodies' bounds in the grid's order (grid_sort, for the pair walks)
         let cell_bounds = storage("grid/cell_bounds", count * size_of::<CellBound>() as u64);
