@@ -13,8 +13,9 @@
 // the block totals of a prefix sum (grid.wgsl's scan): x for the grid, xy for the pairs
 @group(0) @binding(7) var<storage, read_write> block_sums: array<vec2<u32>>;
 // the grid's bodies sorted by cell, then the large bodies (written when the
-// world is made); from body_count on, the step's listed bodies (`listed_body`)
-@group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // 2 x body_count
+// world is made); then the step's lists of bodies, a run of body_count each
+// (`body_in_run`)
+@group(0) @binding(8) var<storage, read_write> sorted: array<u32>;              // 3 x body_count
 // the grid bodies' bounds in sorted's order (CellBound)
 @group(0) @binding(22) var<storage, read_write> cell_bounds: array<CellBoundWords>;  // body_count
 // the pair pipeline (pairs.wgsl, narrowphase.wgsl): candidate pairs, the
@@ -132,42 +133,38 @@ fn set_rest_time(i: u32, rest: f32) {
     state_out[i].a.w = rest;
 }
 
-// The body that invocation k of a body pass (integrate, solve,
-// restitution) works on, or NONE: the k-th body contact_lists listed this
-// step, in sorted[body_count ..] (status[STATUS_LISTED] of them; pairs_count fills the
-// rest of the run with NONE, so no invocation loads the atomic count). Every
-// body is listed but a sleeper the step leaves as it is (`sleeps_held`), whose
-// pose is the same in both state buffers, so a resting pile pays these passes
-// for its few awake bodies. The order depends on thread timing; no result does.
+// The step's lists of bodies, written by contact_lists into runs of `sorted`
+// after the grid's order: run 1, the bodies the body passes (integrate,
+// restitution) work on, every body but a sleeper the step leaves as it is
+// (`sleeps_held`), whose pose is the same in both state buffers, so a resting
+// pile pays these passes for its few awake bodies; run 2, those of them with
+// contacts, which `solve` works on (a body with no contacts has nothing to
+// sum). pairs_count fills both runs with NONE, so no invocation loads a
+// count. The order depends on thread timing; no result does.
+const LISTED_RUN: u32 = 1u;
+const TOUCHING_RUN: u32 = 2u;
+
+// The k-th body of list `run`, or NONE.
+fn body_in_run(run: u32, k: u32) -> u32 {
+    return select(NONE, sorted[run * params.body_count + k], k < params.body_count);
+}
+
 fn listed_body(k: u32) -> u32 {
-    return select(NONE, sorted[params.body_count + k], k < params.body_count);
+    return body_in_run(LISTED_RUN, k);
 }
 
-// Lists body i for the body passes (contact_lists, see `listed_body`): at
-// the next place of sorted's second half, counting one more workgroup of
-// their indirect dispatch (status[STATUS_LISTED_DISPATCH]) with each place that starts one.
-fn list_body(i: u32) {
-    let k = atomicAdd(&status[STATUS_LISTED], 1u);
-    sorted[params.body_count + k] = i;
-    if (k % WORKGROUP == 0u) {
-        atomicAdd(&status[STATUS_LISTED_DISPATCH], 1u);
-    }
-}
-
-// The body that invocation k of `solve` works on, or NONE: the k-th listed
-// body with contacts, in sorted[2 body_count ..] (status[STATUS_TOUCHING] of
-// them; filled with NONE as the listed run is). A body with no contacts has
-// nothing to sum, so `solve` costs a body in flight or hung on joints nothing.
 fn touching_body(k: u32) -> u32 {
-    return select(NONE, sorted[2u * params.body_count + k], k < params.body_count);
+    return body_in_run(TOUCHING_RUN, k);
 }
 
-// Lists body i for `solve` (contact_lists, see `touching_body`), as list_body does.
-fn list_touching(i: u32) {
-    let k = atomicAdd(&status[STATUS_TOUCHING], 1u);
-    sorted[2u * params.body_count + k] = i;
+// Lists body i at the next place of list `run`, counted in status[count],
+// with one more workgroup of its indirect dispatch (status[dispatch]) for
+// each place that starts one.
+fn list_in_run(run: u32, count: u32, dispatch: u32, i: u32) {
+    let k = atomicAdd(&status[count], 1u);
+    sorted[run * params.body_count + k] = i;
     if (k % WORKGROUP == 0u) {
-        atomicAdd(&status[STATUS_TOUCHING_DISPATCH], 1u);
+        atomicAdd(&status[dispatch], 1u);
     }
 }
 

@@ -342,9 +342,9 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     // changes nothing: integrate holds it, restitution copies it), and of
     // them those with contacts for `solve`
     if (!sleeps_held(i) || atomicLoad(&pair_meta[i].woken) != 0u || may_wake) {
-        list_body(i);
+        list_in_run(LISTED_RUN, STATUS_LISTED, STATUS_LISTED_DISPATCH, i);
         if (end > first) {
-            list_touching(i);
+            list_in_run(TOUCHING_RUN, STATUS_TOUCHING, STATUS_TOUCHING_DISPATCH, i);
         }
     }
 }

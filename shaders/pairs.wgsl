@@ -248,8 +248,8 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x < params.body_count) {
         let i = sorted[gid.x];
     // the grid's arrivals are done with: the body lists start empty (`listed_body`, `touching_body`)
-        sorted[params.body_count + gid.x] = NONE;
-        sorted[2u * params.body_count + gid.x] = NONE;
+        sorted[LISTED_RUN * params.body_count + gid.x] = NONE;
+        sorted[TOUCHING_RUN * params.body_count + gid.x] = NONE;
         writing = false;
         room_start = gid.x * scratch_room();
         walk(i);

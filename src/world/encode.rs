@@ -250,6 +250,7 @@ impl World {
             let every: Vec<u32> = (0..n).collect();
             let queue = &self.gpu.queue;
             let all = [self.workgroups(Over::Bodies), 1, 1];
+            // the runs of `sorted` after the grid's order (`body_in_run` in bindings.wgsl)
             for (k, over, count) in
                 [(1, Over::Listed, offset_of!(Status, listed)), (2, Over::Touching, offset_of!(Status, touching))]
             {
