@@ -86,7 +86,7 @@ struct Params {
     opaque_zero: u32,        // always 0; see `opaque` (integrate.wgsl)
     island_count: u32,       // joint islands (joint_rest)
     joint_sweeps: u32,       // the most sweeps along a path per solve_joints pass
-    path_first: u32,         // the paths of this solve_joints pass's colour:
+    path_first: u32,         // the paths of this solve_joints or solve_paths pass's colour:
     path_end: u32,           //   path_first..path_end (joint_lists)
     path_count: u32,         // the paths of every colour
     _pad1: u32,

@@ -497,26 +497,250 @@ fn unwritten(i: u32, held: vec2<u32>, moved: vec2<bool>) -> bool {
     return (held[0] == i && moved[0]) || (held[1] == i && moved[1]);
 }
 
-@compute @workgroup_size(PATH_WORKGROUP)
-fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
+// A cut path's ends as its elimination holds them: the body (NONE for the
+// world or a body the joints do not move), its pose, inverse mass and world
+// inverse inertia.
+struct PathEnd {
+    i: u32,
+    s: BodyState,
+    inv_mass: f32,
+    w: mat3x3<f32>,
+}
+
+fn path_end(i: u32, held: array<PathEnd, 2>) -> PathEnd {
+    if (i == WORLD) {
+        return PathEnd(NONE, BodyState(), 0.0, mat3x3<f32>());
+    }
+    if (held[0].i == i) {
+        return held[0];
+    }
+    if (held[1].i == i) {
+        return held[1];
+    }
+    let s = out_state(i);
+    let p = props_of(i);
+    if (is_fixed(p)) {
+        return PathEnd(NONE, s, 0.0, mat3x3<f32>());
+    }
+    return PathEnd(i, s, p.inv_inertia.w, world_inv_inertia(quat_to_mat(s.rot), p.inv_inertia.xyz));
+}
+
+// [v]x: skew(v) * u = cross(v, u).
+fn skew(v: vec3<f32>) -> mat3x3<f32> {
+    return mat3x3<f32>(vec3<f32>(0.0, v.z, -v.y), vec3<f32>(-v.z, 0.0, v.x), vec3<f32>(v.y, -v.x, 0.0));
+}
+
+// How far end e's point at r moves for a unit push at its point s (world axes).
+fn end_response(e: PathEnd, r: vec3<f32>, s: vec3<f32>) -> mat3x3<f32> {
+    let m = e.inv_mass;
+    return mat3x3<f32>(vec3<f32>(m, 0.0, 0.0), vec3<f32>(0.0, m, 0.0), vec3<f32>(0.0, 0.0, m)) - skew(r) * e.w * skew(s);
+}
+
+// m's inverse, or zero where m is (both ends stay).
+fn inverse3(m: mat3x3<f32>) -> mat3x3<f32> {
+    let r0 = cross(m[1], m[2]);
+    let r1 = cross(m[2], m[0]);
+    let r2 = cross(m[0], m[1]);
+    let det = dot(m[0], r0);
+    let scale = select(0.0, 1.0 / det, det > 0.0);
+    return transpose(mat3x3<f32>(r0, r1, r2)) * scale;
+}
+
+// A joint's world anchors' offsets from its ends' centres, and the part of its
+// gap to close: all of what this substep opened, the old gap at no more than
+// MAX_DEPENETRATION_SPEED (as close_joint).
+struct PathJoint {
+    ra: vec3<f32>,
+    rb: vec3<f32>,
+    close: vec3<f32>,
+}
+
+fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
+    let joined = j.partner != WORLD;
+    let ra = quat_rotate(a.s.rot, j.local_self);
+    let rb = select(vec3<f32>(0.0), quat_rotate(b.s.rot, j.local_partner), joined);
+    let gap = select(j.local_partner, b.s.pos + rb, joined) - (a.s.pos + ra);
+    let dist = length(gap);
+    let moved_a = a.s.disp + (ra - quat_rotate(a.s.prev_rot, j.local_self));
+    let moved_b = select(vec3<f32>(0.0), b.s.disp + (rb - quat_rotate(b.s.prev_rot, j.local_partner)), joined);
+    let before = length(gap - (moved_b - moved_a));
+    let bounded = max(before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
+    let part = select(1.0 - bounded / max(dist, 1e-30), 0.0, dist <= bounded + 1e-7);
+    return PathJoint(ra, rb, gap * part);
+}
+
+// Words of path_scratch a joint of the paths takes: its pivot's inverse with
+// the eliminated gap in w (3), its coupling to the joint before (3; the first's
+// w: which of its ends it shares with that joint, 0 none, 1 body, 2 partner).
+const PATH_SLOT: u32 = 6u;
+
+// One direct solve of a cut path (a chain: each joint shares one body with the
+// next): the 3D gaps of all its joints closed at once, as the linear system
+// of their pushes (block tridiagonal, 3 x 3 blocks) solved by elimination
+// forward and substitution back. What the Gauss-Seidel sweeps approach along
+// the path in many closes, one pass reaches; the colours' turns still carry
+// corrections between paths.
+fn solve_path(first: u32, end: u32, slot0: u32) {
+    let n = end - first;
+    var held: array<PathEnd, 2>;
+    held[0].i = NONE;
+    held[1].i = NONE;
+    var pivot = mat3x3<f32>();  // the joint before's pivot's inverse
+    var gap = vec3<f32>(0.0);   // and its eliminated gap
+    var prev = PathJoint(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var k = 0u; k < n; k = k + 1u) {
+        let j = joint_refs[first + k];
+        let a = path_end(j.body, held);
+        let b = path_end(j.partner, held);
+        let pj = path_joint(j, a, b);
+        var m = end_response(a, pj.ra, pj.ra) + end_response(b, pj.rb, pj.rb);
+        // the body this joint shares with the one before (x: which end here, y: there)
+        var link = vec2<u32>(0u);
+        if (a.i != NONE && a.i == held[0].i) {
+            link = vec2<u32>(1u, 1u);
+        } else if (a.i != NONE && a.i == held[1].i) {
+            link = vec2<u32>(1u, 2u);
+        } else if (b.i != NONE && b.i == held[0].i) {
+            link = vec2<u32>(2u, 1u);
+        } else if (b.i != NONE && b.i == held[1].i) {
+            link = vec2<u32>(2u, 2u);
+        }
+        var coupling = mat3x3<f32>();
+        if (link.x != 0u) {
+            var x = b;
+            if (link.x == 1u) {
+                x = a;
+            }
+            let r_here = select(pj.rb, pj.ra, link.x == 1u);
+            let r_there = select(prev.rb, prev.ra, link.y == 1u);
+            // a joint pushes its body by +lambda and its partner by -lambda
+            let sign = select(-1.0, 1.0, link.x == link.y);
+            coupling = end_response(x, r_here, r_there) * sign;
+            let l = coupling * pivot;
+            m = m - l * transpose(coupling);
+            gap = pj.close - l * gap;
+        } else {
+            gap = pj.close;
+        }
+        pivot = inverse3(m);
+        let at = (slot0 + k) * PATH_SLOT;
+        path_scratch[at] = vec4<f32>(pivot[0], gap.x);
+        path_scratch[at + 1u] = vec4<f32>(pivot[1], gap.y);
+        path_scratch[at + 2u] = vec4<f32>(pivot[2], gap.z);
+        path_scratch[at + 3u] = vec4<f32>(coupling[0], f32(link.x));
+        path_scratch[at + 4u] = vec4<f32>(coupling[1], 0.0);
+        path_scratch[at + 5u] = vec4<f32>(coupling[2], 0.0);
+        held[0] = a;
+        held[1] = b;
+        prev = pj;
+    }
+    // back: each joint's push, each body moved once all its pushes are known
+    // (the body shared with the joint before waits for it in `wait`)
+    var after = vec3<f32>(0.0);      // the coupling of the joint after, times its push, transposed
+    var wait = PathEnd(NONE, BodyState(), 0.0, mat3x3<f32>());
+    var wait_push = vec3<f32>(0.0);  // summed push on `wait`
+    var wait_turn = vec3<f32>(0.0);  // and its moment
+    for (var t = 0u; t < n; t = t + 1u) {
+        let k = n - 1u - t;
+        let at = (slot0 + k) * PATH_SLOT;
+        let w0 = path_scratch[at];
+        let w1 = path_scratch[at + 1u];
+        let w2 = path_scratch[at + 2u];
+        let c0 = path_scratch[at + 3u];
+        let c1 = path_scratch[at + 4u];
+        let c2 = path_scratch[at + 5u];
+        let push = mat3x3<f32>(w0.xyz, w1.xyz, w2.xyz) * (vec3<f32>(w0.w, w1.w, w2.w) - after);
+        after = vec3<f32>(dot(c0.xyz, push), dot(c1.xyz, push), dot(c2.xyz, push));
+        let shares = u32(c0.w);
+        let j = joint_refs[first + k];
+        var none: array<PathEnd, 2>;
+        none[0] = wait;
+        none[1].i = NONE;
+        let a = path_end(j.body, none);
+        let b = path_end(j.partner, none);
+        let pj = path_joint(j, a, b);
+        // the body the joint after left waiting, before this joint's end takes its place
+        let waited = wait.i;
+        let waited_push = wait_push;
+        let waited_turn = wait_turn;
+        for (var e = 0u; e < 2u; e = e + 1u) {
+            var x = b;
+            if (e == 0u) {
+                x = a;
+            }
+            if (x.i == NONE) {
+                continue;
+            }
+            let p = push * select(-1.0, 1.0, e == 0u);
+            var total = p;
+            var turn = cross(select(pj.rb, pj.ra, e == 0u), p);
+            if (x.i == waited) {
+                total = total + waited_push;
+                turn = turn + waited_turn;
+            }
+            if (shares == e + 1u) {
+                wait = x;
+                wait_push = total;
+                wait_turn = turn;
+            } else {
+                let dx = total * x.inv_mass;
+                x.s.pos = x.s.pos + dx;
+                x.s.disp = x.s.disp + dx;
+                x.s.rot = quat_add_rotation(x.s.rot, x.w * turn);
+                set_state(x.i, x.s);
+            }
+        }
+        if (shares == 0u) {
+            wait.i = NONE;
+        }
+    }
+}
+
+// The joints of path gid.x of this pass's colour, if it is of the kind asked
+// (cut from a larger island, or whole) and its island is awake:
+// (first, end) in joint_refs, or (NONE, NONE).
+fn colour_path(gid: vec3<u32>, cut: bool) -> vec2<u32> {
     let path = params.path_first + gid.x;
     if (path >= params.path_end) {
-        return;
+        return vec2<u32>(NONE);
     }
-    // path p's joints follow the islands' in joint_start
+    // path p's joints follow the islands' in joint_start, and after all
+    // paths, each one's closes a solve_joints pass: 0 for a cut path (joint_lists)
     let at = params.body_count + params.island_count + 2u + path;
+    if ((joint_start[at + 1u + params.path_count] == 0u) != cut) {
+        return vec2<u32>(NONE);
+    }
     let first = joint_start[at];
-    let end = joint_start[at + 1u];
     // an asleep island is left as it is (joint_rest shares its rest time)
     if (params.sleep_after > 0.0 && out_state(joint_refs[first].body).rest_time >= params.sleep_after) {
+        return vec2<u32>(NONE);
+    }
+    return vec2<u32>(first, joint_start[at + 1u]);
+}
+
+// Pass "solve_paths", twice a substep (after its first solve and its last),
+// once per colour, one invocation per path cut from a larger island: the
+// path solved directly (solve_path).
+@compute @workgroup_size(PATH_WORKGROUP)
+fn solve_paths(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let path = colour_path(gid, true);
+    if (path.x != NONE) {
+        solve_path(path.x, path.y, path.x - joint_start[params.body_count + params.island_count + 2u]);
+    }
+}
+
+@compute @workgroup_size(PATH_WORKGROUP)
+fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let path = colour_path(gid, false);
+    if (path.x == NONE) {
         return;
     }
+    let first = path.x;
+    let end = path.y;
     // the sweeps out and back as one loop counted by the path's length (a loop
-    // bounded by a uniform alone is recompiled by lavapipe every dispatch), up to
-    // params.joint_sweeps within the path's budget of closes (CUT_PATH_CLOSES)
+    // bounded by a uniform alone is recompiled by lavapipe every dispatch)
     let n = end - first;
-    let closes = joint_start[params.body_count + params.island_count + 3u + params.path_count + path];
-    let sweeps = max(min(params.joint_sweeps, closes / (2u * n)), 1u);
+    let sweeps = params.joint_sweeps;
     // Consecutive joints of a path share a body, so the two bodies of the last
     // joint closed stay in registers (held[k], its state kept[k], moved[k] if
     // not yet written back) rather than going to memory and back each close.

@@ -122,7 +122,7 @@ pub struct Params {
     pub island_count: u32,
     /// The most Gauss-Seidel sweeps along a path per `solve_joints` pass.
     pub joint_sweeps: u32,
-    /// The paths of this `solve_joints` pass's colour: `path_first..path_end`.
+    /// The paths of this `solve_joints` or `solve_paths` pass's colour: `path_first..path_end`.
     pub path_first: u32,
     pub path_end: u32,
     /// The paths of every colour (their budgets follow their starts in
@@ -322,7 +322,7 @@ pub const LARGE_BODY: u32 = 1;
 /// Threads per workgroup of every per-body pass (`WORKGROUP` in WGSL).
 pub const WORKGROUP: u32 = 64;
 
-/// Threads per workgroup of `solve_joints`, one a joint path: a colour may
+/// Threads per workgroup of `solve_joints` and `solve_paths`, one a joint path: a colour may
 /// have a few paths only, each a long serial loop, and small workgroups
 /// spread them evenly over a software adapter's threads (`PATH_WORKGROUP`
 /// in WGSL).

@@ -34,10 +34,12 @@ pub enum Buffer {
     IslandRest = 23,
     /// The hull records (src/world/hull_records.rs).
     Hulls = 24,
+    /// `solve_joints`' elimination along the cut paths (`PATH_SLOT_BYTES` a path joint).
+    PathScratch = 25,
 }
 
 impl Buffer {
-    pub const ALL: [Buffer; 25] = [
+    pub const ALL: [Buffer; 26] = [
         Buffer::Params,
         Buffer::Props,
         Buffer::StateIn,
@@ -63,6 +65,7 @@ impl Buffer {
         Buffer::CellBounds,
         Buffer::IslandRest,
         Buffer::Hulls,
+        Buffer::PathScratch,
     ];
 
     pub fn binding(self) -> u32 {

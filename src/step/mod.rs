@@ -8,11 +8,12 @@
 //!    clips the face contacts, over the top run of the pool
 //! 4. `integrate`    — Verlet prediction of every pose (shaders/integrate.wgsl), after
 //!    applying the last substep's restitution in a step's later substeps
-//! 5. `solve_contacts`, `solve`, `joint_rest_*`, `solve_joints` — the substep's share of the
-//!    `iterations` sweeps of corrective snaps: per manifold what it asks of its bodies, then
-//!    per body the sum (Jacobi), then (only in scenes with joints; `joint_rest` once a
-//!    substep) per colour of joint paths each path's joints in turn (Gauss-Seidel)
-//!    (shaders/solve.wgsl)
+//! 5. `solve_contacts`, `solve`, `joint_rest_*`, `solve_joints`, `solve_paths` — the
+//!    substep's share of the `iterations` sweeps of corrective snaps: per manifold what it
+//!    asks of its bodies, then per body the sum (Jacobi), then (only in scenes with joints;
+//!    `joint_rest` once a substep) per colour of joint paths each whole island's joints in
+//!    turn (Gauss-Seidel), and after the substep's last sweep each path cut from a larger
+//!    island solved directly (shaders/solve.wgsl)
 //! 6. `restitution_contacts`, `restitution` — bounce and dynamic friction, by
 //!    rewriting the previous pose, in the same two halves (shaders/restitution.wgsl);
 //!    the body half as a pass only after the last substep (the next `integrate`

@@ -31,6 +31,7 @@ pub enum Stage {
     JointRestGather,
     JointRest,
     SolveJoints,
+    SolvePaths,
     RestitutionContacts,
     Restitution,
 }
@@ -161,7 +162,7 @@ impl StageInfo {
 }
 
 /// Every stage, in the order of `Stage` (checked as the table is built).
-pub(crate) const TABLE: [StageInfo; 24] = {
+pub(crate) const TABLE: [StageInfo; 25] = {
     use shaders::{GRID_PASS, INTEGRATE_PASS, NARROWPHASE_PASS, PAIRS_PASS, RESTITUTION_PASS, SOLVE_PASS};
     use Buffer::*;
     use Part::{Broadphase, Narrowphase};
@@ -326,6 +327,14 @@ pub(crate) const TABLE: [StageInfo; 24] = {
             reads: JOINT_READS,
             writes: &[StateOut],
             ..S::row(Stage::SolveJoints, "solve_joints", SOLVE_PASS, Part::Solve)
+        },
+        S {
+            over: Over::Paths,
+            poses: Poses::InPlace,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateOut, JointStart, JointRefs, PathScratch],
+            writes: &[StateOut, PathScratch],
+            ..S::row(Stage::SolvePaths, "solve_paths", SOLVE_PASS, Part::Solve)
         },
         S {
             over: Over::Manifolds,

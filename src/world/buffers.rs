@@ -47,6 +47,9 @@ pub(super) struct WorldData {
     /// Each joint island's two words for `joint_rest` (its least rest time
     /// and whether it is held), emptied before each use.
     pub island_rest: wgpu::Buffer,
+    /// `solve_joints`' elimination along the cut paths, a slot a path joint,
+    /// written and read within one pass.
+    pub path_scratch: wgpu::Buffer,
     /// Working buffers of the passes: vel0, and the grid's cell_count,
     /// cell_start, block_sums, sorted and cell_bounds.
     pub scratch: [wgpu::Buffer; 6],
@@ -146,6 +149,7 @@ impl WorldData {
             props: props_buffer(device, n),
             statics: statics_buffers(device, statics),
             island_rest: island_rest_buffer(device, joints),
+            path_scratch: path_scratch_buffer(device, joints),
             scratch,
             batch_start: [batch_state, storage("batch start/status", Status::BYTES)],
         };
@@ -193,6 +197,11 @@ impl WorldData {
                 self.island_rest.clone()
             } else {
                 island_rest_buffer(device, joints)
+            },
+            path_scratch: if self.path_scratch.size() >= path_scratch_bytes(joints) {
+                self.path_scratch.clone()
+            } else {
+                path_scratch_buffer(device, joints)
             },
             scratch,
             batch_start: [batch_state, self.batch_start[1].clone()],
@@ -266,6 +275,7 @@ impl WorldData {
             Buffer::BodyPairs => &self.body_pairs,
             Buffer::CellBounds => cell_bounds,
             Buffer::IslandRest => &self.island_rest,
+            Buffer::PathScratch => &self.path_scratch,
             Buffer::Hulls => hulls,
         }
     }
@@ -310,6 +320,7 @@ impl WorldData {
             &self.dispatch,
             &self.props,
             &self.island_rest,
+            &self.path_scratch,
         ];
         buffers.iter().map(|b| b.size()).sum::<u64>()
             + self.states.iter().chain(&self.statics).chain(&self.scratch).chain(&self.batch_start).map(|b| b.size()).sum::<u64>()
@@ -378,6 +389,22 @@ fn island_rest_bytes(joints: &JointLists) -> u64 {
 
 fn island_rest_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffer {
     storage_buffer(device, "joints/island_rest", island_rest_bytes(joints))
+}
+
+/// Bytes of a path joint's elimination in `WorldData::path_scratch`
+/// (`PATH_SLOT` vec4 words in shaders/solve.wgsl).
+pub(crate) const PATH_SLOT_BYTES: u64 = 6 * 16;
+
+/// Bytes of `WorldData::path_scratch`: where some paths are cut from a
+/// larger island, a slot for every joint of the paths (a path's slots
+/// follow its place among them); else one.
+fn path_scratch_bytes(joints: &JointLists) -> u64 {
+    let (_, cut) = joints.path_kinds();
+    PATH_SLOT_BYTES * if cut { u64::from(joints.path_joints().max(1)) } else { 1 }
+}
+
+fn path_scratch_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffer {
+    storage_buffer(device, "joints/path_scratch", path_scratch_bytes(joints))
 }
 
 /// The statics (`WorldData::statics`), exactly as large as their lists.

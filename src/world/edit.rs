@@ -135,6 +135,7 @@ impl World {
         self.island_count = joints.islands;
         self.has_hulls = !hulls.is_empty();
         self.island_joints = joints.island_joints(n);
+        self.path_kinds = joints.path_kinds();
         self.path_colours = joints.colours;
         self.scene = scene;
         // both state buffers hold the poses

@@ -191,14 +191,30 @@ impl World {
         for sub in 0..self.settings.substeps as usize {
             let at = sub * per_substep;
             plan.push((Stage::Integrate, at));
-            for sweep in 0..self.settings.sweeps(sub as u32) {
+            let sweeps = self.settings.sweeps(sub as u32);
+            let (whole, cut) = self.path_kinds;
+            for sweep in 0..sweeps {
                 plan.extend([(Stage::SolveContacts, at), (Stage::Solve, at)]);
                 if self.island_count > 0 {
                     // islands sleep as one only where bodies sleep at all
                     if sweep == 0 && self.settings.sleeping {
                         plan.extend([Stage::JointRestClear, Stage::JointRestGather, Stage::JointRest].map(|s| (s, at)));
                     }
-                    plan.extend((1..per_substep).map(|c| (Stage::SolveJoints, at + c)));
+                    if whole {
+                        plan.extend((1..per_substep).map(|c| (Stage::SolveJoints, at + c)));
+                    }
+                    // the cut paths twice a substep: after its first sweep and after
+                    // its last, both after a single one (docs/decisions/joints.md)
+                    let rounds = match (sweep == 0, sweep + 1 == sweeps) {
+                        (true, true) => 2,
+                        (true, false) | (false, true) => 1,
+                        (false, false) => 0,
+                    };
+                    if cut {
+                        for _ in 0..rounds {
+                            plan.extend((1..per_substep).map(|c| (Stage::SolvePaths, at + c)));
+                        }
+                    }
                 }
             }
             plan.push((Stage::RestitutionContacts, at));

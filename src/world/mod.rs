@@ -71,8 +71,11 @@ pub struct World {
     /// for each.
     island_joints: u32,
     /// Where each colour of the joint paths begins, and after the last its
-    /// end (`JointLists::colours`): `solve_joints` runs once per colour.
+    /// end (`JointLists::colours`): `solve_joints` and `solve_paths` run once per colour.
     path_colours: Vec<u32>,
+    /// Whether some paths are whole islands (`solve_joints` runs), and
+    /// whether some are cut from larger ones (`solve_paths` runs).
+    path_kinds: (bool, bool),
     /// Whether the bodies' speed limits (`BodyProps::speed_limit`, from the
     /// scene's energy) still hold: no input, edit or restore since.
     speed_limits: bool,
@@ -140,6 +143,7 @@ impl World {
             has_hulls: !hulls.is_empty(),
             island_joints: joints.island_joints(n),
             path_colours: joints.colours.clone(),
+            path_kinds: joints.path_kinds(),
             speed_limits: true,
             current: 0,
             step: 0,

@@ -111,20 +111,22 @@ pub(crate) fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], not_free: b
 ///   first from the bodies joined to the world or a fixed body, else from
 ///   its lowest body). Joints between two fixed bodies are left out:
 ///   nothing can move them.
-/// - After the islands, the paths `solve_joints` sweeps (path p's joints
-///   are `refs[starts[n + islands + 2 + p]..]`): every joint once, an
+/// - After the islands, the paths `solve_joints` and `solve_paths` solve
+///   (path p's joints are `refs[starts[n + islands + 2 + p]..]`): every joint once, an
 ///   island of at most `PATH_JOINTS` joints as one path in its order (a
 ///   chain, a bridge, a ragdoll), a larger one cut into runs of at most
 ///   `PATH_JOINTS` joints that go on through a shared body as nearly
 ///   straight as they can, from where the island is held (a hanging grid's
 ///   columns, then its rows), each joint seen from the end it shares with
 ///   the one before it, so a forward sweep carries a correction along the
-///   path and a backward one back. After the paths' starts, each path's
-///   most joint closes a pass (`CUT_PATH_CLOSES`, or `u32::MAX` for a whole
-///   island). They come by colour: no two
-///   paths of one colour share a movable body, so `solve_joints` sweeps a
-///   colour's paths side by side, one invocation each, and the colours one
-///   after the other (Gauss-Seidel along a path and between colours).
+///   path and a backward one back; a cut path never comes back to a body
+///   it holds, so that it is a chain. After the paths' starts, each path's
+///   joint closes a `solve_joints` pass: `u32::MAX` for a whole island (as
+///   many sweeps as the pass asks), 0 for a path cut from a larger one
+///   (`solve_paths` solves it directly, as one system). They come by
+///   colour: no two paths of one colour share a movable body, so a
+///   colour's paths are solved side by side, one invocation each, and the
+///   colours one after the other (Gauss-Seidel between colours).
 pub(crate) struct JointLists {
     pub starts: Vec<u32>,
     pub refs: Vec<JointRef>,
@@ -134,19 +136,10 @@ pub(crate) struct JointLists {
     pub colours: Vec<u32>,
 }
 
-/// The most joints of one path: an invocation sweeps it forward and back,
-/// within the driver's loop limit with room to spare (`solve_joints`), and
+/// The most joints of one path: an invocation goes along it forward and
+/// back, within the driver's loop limit with room to spare, and
 /// long enough that a chain or a row of a grid is one path.
 pub(crate) const PATH_JOINTS: usize = 128;
-
-/// The joint closes a path cut from a large island makes in one
-/// `solve_joints` pass at most: min(joint_sweeps, this / 2n) sweeps of its
-/// n joints, at least one (a whole island's path makes every sweep the
-/// pass asks). A column of 100 joints of Box3D's grid makes 2, and the
-/// colours' turns carry the rest: the grid of 100 x 100 opened 7.4 mm in 5
-/// s at the defaults, 7.5 with 3 sweeps a pass, 8.0 with 5 at 2.8 times
-/// the cost, 24 with one.
-pub(crate) const CUT_PATH_CLOSES: u32 = 512;
 
 impl JointLists {
     /// The joints of all the islands' lists (`joint_rest`'s invocations),
@@ -155,7 +148,22 @@ impl JointLists {
         self.starts[bodies + 1 + self.islands as usize] - self.starts[bodies + 1]
     }
 
-    /// The paths' colours: `solve_joints` is dispatched once per colour.
+    /// The joints of the paths (every joint of the islands, once).
+    pub(crate) fn path_joints(&self) -> u32 {
+        let paths = self.colours.last().copied().unwrap_or(0) as usize;
+        let first = self.starts.len() - 2 * paths - 1;
+        self.refs.len() as u32 - self.starts[first]
+    }
+
+    /// Whether some paths are whole islands (`solve_joints`), and whether
+    /// some are cut from larger ones (`solve_paths`).
+    pub(crate) fn path_kinds(&self) -> (bool, bool) {
+        let paths = self.colours.last().copied().unwrap_or(0) as usize;
+        let closes = &self.starts[self.starts.len() - paths..];
+        (closes.contains(&u32::MAX), closes.contains(&0))
+    }
+
+    /// The paths' colours: `solve_joints` and `solve_paths` are dispatched once per colour.
     pub(crate) fn colour_count(&self) -> u32 {
         self.colours.len().saturating_sub(1) as u32
     }
@@ -258,7 +266,7 @@ pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
     for (path, whole) in paths {
         starts.push(refs.len() as u32);
         refs.extend(path);
-        closes.push(if whole { u32::MAX } else { CUT_PATH_CLOSES });
+        closes.push(if whole { u32::MAX } else { 0 });
     }
     starts.push(refs.len() as u32);
     starts.extend(closes);
@@ -376,7 +384,11 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         let anchored = !movable(r.partner);
         let (mut end, mut from) = if anchored { (r.body, r.local_self) } else { (r.partner, r.local_partner) };
         while path.len() < PATH_JOINTS {
-            let Some((_, e)) = straightest(end, from, &mut taken) else { break };
+            let Some((k, e)) = straightest(end, from, &mut taken) else { break };
+            if bodies.contains(&e.partner) {
+                taken[k] = false;
+                break;
+            }
             path.push(e);
             (end, from) = (e.partner, e.local_partner);
             bodies.extend([end].into_iter().filter(|&b| movable(b)));
@@ -386,6 +398,10 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         let (mut start, mut from) = (r.body, r.local_self);
         while !anchored && path.len() < PATH_JOINTS {
             let Some((k, e)) = straightest(start, from, &mut taken) else { break };
+            if bodies.contains(&e.partner) {
+                taken[k] = false;
+                break;
+            }
             // seen from the far end, so that the path reads on into its start
             path.insert(0, end_at(k, e.partner));
             (start, from) = (e.partner, e.local_partner);
@@ -679,11 +695,12 @@ mod tests {
                 lists.starts[first..first + count + 1].windows(2).map(|w| &lists.refs[w[0] as usize..w[1] as usize]).collect();
             let moving = |b: u32| b != WORLD && scene.bodies[b as usize].is_dynamic();
             let solved = scene.joints.iter().filter(|j| j.bodies.iter().any(|&b| b >= 0 && moving(b as u32))).count();
-            // whole islands sweep as the pass asks, cut paths within a budget
-            let closes = &lists.starts[first + count + 1..];
-            assert_eq!(closes.len(), count, "{name}");
+            // whole islands are swept, paths cut from larger ones solved directly
+            let cut = &lists.starts[first + count + 1..];
+            assert_eq!(cut.len(), count, "{name}");
             let whole = solved <= PATH_JOINTS;
-            assert!(closes.iter().all(|&c| c == if whole { u32::MAX } else { CUT_PATH_CLOSES }), "{name}");
+            assert!(cut.iter().all(|&c| c == if whole { u32::MAX } else { 0 }), "{name}");
+            assert_eq!(lists.path_kinds(), (whole && count > 0, !whole), "{name}");
             assert_eq!(paths.iter().map(|p| p.len()).sum::<usize>(), solved, "{name}: every joint once");
             for p in &paths {
                 assert!(p.len() <= PATH_JOINTS, "{name}: a path of {}", p.len());
@@ -691,6 +708,13 @@ mod tests {
                 if solved > PATH_JOINTS {
                     for w in p.windows(2) {
                         assert!(w[1].body == w[0].partner || w[1].body == w[0].body, "{name}: a path jumps");
+                    }
+                    // and is a chain: joints two or more apart share no body
+                    for (k, r) in p.iter().enumerate() {
+                        for later in p.iter().skip(k + 2) {
+                            let shares = |b: u32| moving(b) && (b == later.body || b == later.partner);
+                            assert!(!shares(r.body) && !shares(r.partner), "{name}: a cut path comes back to a body");
+                        }
                     }
                 }
             }

@@ -57,7 +57,8 @@
 //! 1's velocity was), no rounding remainder, and the flag as it was. Their
 //! runs then continue as this build runs them, not bit for bit as the runs
 //! they were taken from. The scene hash covers the joint lists as the GPU
-//! holds them (the islands and the paths `solve_joints` sweeps among them):
+//! holds them (the islands and the paths `solve_joints` and `solve_paths`
+//! solve among them):
 //! a snapshot of a scene with joints taken by a build that listed them
 //! otherwise is refused as another scene's.
 
