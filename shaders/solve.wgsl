@@ -1,6 +1,6 @@
-// Passes "solve_contacts", "solve", "joint_rest" and "solve_joints", run in
-// each substep its share of `iterations` times: the paper's corrective snaps
-// (eqs. 9-10). Contacts are relaxed Jacobi style from state_in: solve_contacts
+// Passes "solve_contacts", "solve", "joint_rest", "solve_joints" and
+// "solve_paths", run in each substep its share of `iterations` times
+// (solve_paths twice): the paper's corrective snaps (eqs. 9-10). Contacts are relaxed Jacobi style from state_in: solve_contacts
 // (per manifold) writes what a pair's points ask of each body (two EndSnaps),
 // and solve (per listed body with contacts) sums them in pair order, relaxes
 // the sum by c_r and moves its own pose in place (bound as state_out: every
@@ -341,8 +341,10 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
 }
 
 // Pass "solve_joints", after every solve, once per colour of joint paths
-// (joint_lists in src/world/records.rs), one invocation per path: closes the
-// path's joints one after the other, outward and back, in place. A Jacobi sum
+// (joint_lists in src/world/records.rs), one invocation per path of a whole
+// island (of at most 128 joints; solve_paths takes the paths cut from larger
+// ones): closes the path's joints one after the other, outward and back, in
+// place. A Jacobi sum
 // carries a correction one link per sweep; a sweep along the path carries it
 // all the way. No two paths of a colour share a body that moves, and a path's
 // order is fixed, so nothing depends on thread timing. See docs/decisions/joints.md.
@@ -569,9 +571,10 @@ fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
     return PathJoint(ra, rb, gap * part);
 }
 
-// Words of path_scratch a joint of the paths takes: its pivot's inverse with
-// the eliminated gap in w (3), its coupling to the joint before (3; the first's
-// w: which of its ends it shares with that joint, 0 none, 1 body, 2 partner).
+// Words of path_scratch a joint of the paths takes: its pivot's inverse, the
+// eliminated gap in the w's (3); its coupling to the joint before, the first
+// word's w saying which of its ends it shares with that joint (0 none, 1 its
+// body, 2 its partner) (3).
 const PATH_SLOT: u32 = 6u;
 
 // One direct solve of a cut path (a chain: each joint shares one body with the
