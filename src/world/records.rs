@@ -115,7 +115,7 @@ pub(crate) fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], not_free: b
 ///   (path p's joints are `refs[starts[n + islands + 2 + p]..]`): every joint once, an
 ///   island of at most `PATH_JOINTS` joints as one path in its order (a
 ///   chain, a bridge, a ragdoll), a larger one cut into runs of at most
-///   `PATH_JOINTS` joints that go on through a shared body as nearly
+///   `CUT_PATH_JOINTS` joints that go on through a shared body as nearly
 ///   straight as they can, from where the island is held (a hanging grid's
 ///   columns, then its rows), each joint seen from the end it shares with
 ///   the one before it, so a forward sweep carries a correction along the
@@ -136,10 +136,19 @@ pub(crate) struct JointLists {
     pub colours: Vec<u32>,
 }
 
-/// The most joints of one path: an invocation goes along it forward and
-/// back, within the driver's loop limit with room to spare, and
-/// long enough that a chain or a row of a grid is one path.
+/// The most joints of an island swept whole as one path (`solve_joints`):
+/// its sweeps out and back stay within the driver's loop limit with room to
+/// spare. A larger island is cut (`CUT_PATH_JOINTS`).
 pub(crate) const PATH_JOINTS: usize = 128;
+
+/// The most joints of a path cut from a larger island: `solve_paths` takes
+/// it in 4n loop trips, well within the driver's limit, and a chain of up to
+/// this many links is one path, solved whole. Where two paths meet, each
+/// solve moves the body they share as if its own path alone held it: a chain
+/// of 200 links cut at 128 joints, whipping down from its pin at 50 m/s,
+/// opened the joint where its paths met by 118 mm for a moment; whole, 0.02
+/// mm (docs/decisions/joints.md).
+pub(crate) const CUT_PATH_JOINTS: usize = 1024;
 
 impl JointLists {
     /// The joints of all the islands' lists (`joint_rest`'s invocations),
@@ -383,7 +392,7 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         // the path came in
         let anchored = !movable(r.partner);
         let (mut end, mut from) = if anchored { (r.body, r.local_self) } else { (r.partner, r.local_partner) };
-        while path.len() < PATH_JOINTS {
+        while path.len() < CUT_PATH_JOINTS {
             let Some((k, e)) = straightest(end, from, &mut taken) else { break };
             if bodies.contains(&e.partner) {
                 taken[k] = false;
@@ -396,7 +405,7 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         // and back from its start, where it does not start at an anchor (a
         // row found in its middle is one path, not two)
         let (mut start, mut from) = (r.body, r.local_self);
-        while !anchored && path.len() < PATH_JOINTS {
+        while !anchored && path.len() < CUT_PATH_JOINTS {
             let Some((k, e)) = straightest(start, from, &mut taken) else { break };
             if bodies.contains(&e.partner) {
                 taken[k] = false;
@@ -703,7 +712,7 @@ mod tests {
             assert_eq!(lists.path_kinds(), (whole && count > 0, !whole), "{name}");
             assert_eq!(paths.iter().map(|p| p.len()).sum::<usize>(), solved, "{name}: every joint once");
             for p in &paths {
-                assert!(p.len() <= PATH_JOINTS, "{name}: a path of {}", p.len());
+                assert!(p.len() <= if whole { PATH_JOINTS } else { CUT_PATH_JOINTS }, "{name}: a path of {}", p.len());
                 // a large island's paths go on through shared bodies
                 if solved > PATH_JOINTS {
                     for w in p.windows(2) {
@@ -734,6 +743,8 @@ mod tests {
         // a chain hung from the world is one path; a large grid's columns
         // are one colour and its rows the other
         assert_eq!(joint_lists(&crate::scenes::chain(21)).colour_count(), 1);
+        // a chain of up to CUT_PATH_JOINTS links is one cut path
+        assert_eq!(joint_lists(&crate::scenes::chain(300)).colour_count(), 1);
         assert_eq!(joint_lists(&crate::scenes::joint_grid(100)).colour_count(), 2);
     }
 }
