@@ -1,7 +1,7 @@
 // Passes "solve_contacts", "solve", "joint_rest", "solve_joints" and
 // "solve_paths", run in each substep its share of `iterations` times
-// (solve_paths twice): the paper's corrective snaps (eqs. 9-10). Contacts are relaxed Jacobi style from state_in: solve_contacts
-// (per manifold) writes what a pair's points ask of each body (two EndSnaps),
+// (solve_paths twice): the paper's corrective snaps (eqs. 9-10). Contacts are
+// relaxed Jacobi style from state_in: solve_contacts (per manifold) writes what a pair's points ask of each body (two EndSnaps),
 // and solve (per listed body with contacts) sums them in pair order, relaxes
 // the sum by c_r and moves its own pose in place (bound as state_out: every
 // snap was measured in the pass before). All of a body's snaps are measured on
@@ -557,10 +557,17 @@ struct PathJoint {
     close: vec3<f32>,
 }
 
+// The offsets alone: ra, then rb.
+fn path_anchors(j: JointRef, a: PathEnd, b: PathEnd) -> array<vec3<f32>, 2> {
+    return array<vec3<f32>, 2>(quat_rotate(a.s.rot, j.local_self),
+                               select(vec3<f32>(0.0), quat_rotate(b.s.rot, j.local_partner), j.partner != WORLD));
+}
+
 fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
     let joined = j.partner != WORLD;
-    let ra = quat_rotate(a.s.rot, j.local_self);
-    let rb = select(vec3<f32>(0.0), quat_rotate(b.s.rot, j.local_partner), joined);
+    let r = path_anchors(j, a, b);
+    let ra = r[0];
+    let rb = r[1];
     let gap = select(j.local_partner, b.s.pos + rb, joined) - (a.s.pos + ra);
     let dist = length(gap);
     let moved_a = a.s.disp + (ra - quat_rotate(a.s.prev_rot, j.local_self));
@@ -571,11 +578,10 @@ fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
     return PathJoint(ra, rb, gap * part);
 }
 
-// Words of path_scratch a joint of the paths takes: its pivot's inverse, the
+// A joint's PATH_SLOT words of path_scratch: its pivot's inverse, the
 // eliminated gap in the w's (3); its coupling to the joint before, the first
 // word's w saying which of its ends it shares with that joint (0 none, 1 its
 // body, 2 its partner) (3).
-const PATH_SLOT: u32 = 6u;
 
 // One direct solve of a cut path (a chain: each joint shares one body with the
 // next): the 3D gaps of all its joints closed at once, as the linear system
@@ -656,12 +662,12 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         after = vec3<f32>(dot(c0.xyz, push), dot(c1.xyz, push), dot(c2.xyz, push));
         let shares = u32(c0.w);
         let j = joint_refs[first + k];
-        var none: array<PathEnd, 2>;
-        none[0] = wait;
-        none[1].i = NONE;
-        let a = path_end(j.body, none);
-        let b = path_end(j.partner, none);
-        let pj = path_joint(j, a, b);
+        var kept: array<PathEnd, 2>;
+        kept[0] = wait;
+        kept[1].i = NONE;
+        let a = path_end(j.body, kept);
+        let b = path_end(j.partner, kept);
+        let r = path_anchors(j, a, b);
         // the body the joint after left waiting, before this joint's end takes its place
         let waited = wait.i;
         let waited_push = wait_push;
@@ -676,7 +682,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
             }
             let p = push * select(-1.0, 1.0, e == 0u);
             var total = p;
-            var turn = cross(select(pj.rb, pj.ra, e == 0u), p);
+            var turn = cross(select(r[1], r[0], e == 0u), p);
             if (x.i == waited) {
                 total = total + waited_push;
                 turn = turn + waited_turn;

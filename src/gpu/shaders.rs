@@ -40,6 +40,7 @@ pub fn shared_constants() -> String {
         ("LARGE_BODY", LARGE_BODY),
         ("WORKGROUP", WORKGROUP),
         ("PATH_WORKGROUP", PATH_WORKGROUP),
+        ("PATH_SLOT", PATH_SLOT),
         ("SCAN_BLOCK", SCAN_BLOCK),
         ("SCAN_RUN", SCAN_RUN),
         ("SCAN_SPAN", SCAN_SPAN),

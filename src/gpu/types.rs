@@ -328,6 +328,11 @@ pub const WORKGROUP: u32 = 64;
 /// in WGSL).
 pub const PATH_WORKGROUP: u32 = 8;
 
+/// vec4 words of `path_scratch` a joint of the paths takes (`PATH_SLOT` in
+/// WGSL; shaders/solve.wgsl's `solve_path`): its pivot's inverse with the
+/// eliminated gap (3), its coupling to the joint before (3).
+pub const PATH_SLOT: u32 = 6;
+
 /// Byte stride between the per-step `Params` slots of a batch: the
 /// uniform-buffer offset alignment WebGPU guarantees to work everywhere.
 pub(crate) const PARAMS_STRIDE: u64 = 256;

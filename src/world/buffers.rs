@@ -391,16 +391,12 @@ fn island_rest_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffe
     storage_buffer(device, "joints/island_rest", island_rest_bytes(joints))
 }
 
-/// Bytes of a path joint's elimination in `WorldData::path_scratch`
-/// (`PATH_SLOT` vec4 words in shaders/solve.wgsl).
-pub(crate) const PATH_SLOT_BYTES: u64 = 6 * 16;
-
 /// Bytes of `WorldData::path_scratch`: where some paths are cut from a
 /// larger island, a slot for every joint of the paths (a path's slots
 /// follow its place among them); else one.
 fn path_scratch_bytes(joints: &JointLists) -> u64 {
     let (_, cut) = joints.path_kinds();
-    PATH_SLOT_BYTES * if cut { u64::from(joints.path_joints().max(1)) } else { 1 }
+    16 * u64::from(PATH_SLOT) * if cut { u64::from(joints.path_joints().max(1)) } else { 1 }
 }
 
 fn path_scratch_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffer {

@@ -205,11 +205,7 @@ impl World {
                     }
                     // the cut paths twice a substep: after its first sweep and after
                     // its last, both after a single one (docs/decisions/joints.md)
-                    let rounds = match (sweep == 0, sweep + 1 == sweeps) {
-                        (true, true) => 2,
-                        (true, false) | (false, true) => 1,
-                        (false, false) => 0,
-                    };
+                    let rounds = usize::from(sweep == 0) + usize::from(sweep + 1 == sweeps);
                     if cut {
                         for _ in 0..rounds {
                             plan.extend((1..per_substep).map(|c| (Stage::SolvePaths, at + c)));
