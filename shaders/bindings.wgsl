@@ -49,7 +49,7 @@ override LOOP_TRIPS: u32 = 0xffffffffu;
 // the hull records (src/world/hull_records.rs): a run of words per hull
 // shape, the first the cube of half extent 1 that a box is scaled from
 @group(0) @binding(24) var<storage, read> hulls: array<vec4<f32>>;
-// solve_paths' elimination along the cut paths, PATH_SLOT words a joint of the paths (solve_path in solve.wgsl)
+// solve_paths' elimination along its paths, PATH_SLOT words a joint of the paths (solve_path in solve.wgsl)
 @group(0) @binding(25) var<storage, read_write> path_scratch: array<vec4<f32>>;
 
 // The busiest buffers are bound as vec4 words (the same bytes as their

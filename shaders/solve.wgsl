@@ -341,10 +341,10 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
 }
 
 // Pass "solve_joints", after every solve, once per colour of joint paths
-// (joint_lists in src/world/records.rs), one invocation per path of a whole
-// island (of at most 128 joints; solve_paths takes the paths cut from larger
-// ones): closes the path's joints one after the other, outward and back, in
-// place. A Jacobi sum
+// (joint_lists in src/world/records.rs), one invocation per path of an
+// island with a branch or a loop (of at most 128 joints; solve_paths takes
+// chains and the paths cut from larger islands): closes the path's joints
+// one after the other, outward and back, in place. A Jacobi sum
 // carries a correction one link per sweep; a sweep along the path carries it
 // all the way. No two paths of a colour share a body that moves, and a path's
 // order is fixed, so nothing depends on thread timing. See docs/decisions/joints.md.
@@ -499,7 +499,7 @@ fn unwritten(i: u32, held: vec2<u32>, moved: vec2<bool>) -> bool {
     return (held[0] == i && moved[0]) || (held[1] == i && moved[1]);
 }
 
-// A cut path's ends as its elimination holds them: the body (NONE for the
+// A direct path's ends as its elimination holds them: the body (NONE for the
 // world or a body the joints do not move), its pose, inverse mass and world
 // inverse inertia.
 struct PathEnd {
@@ -583,8 +583,8 @@ fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
 // word's w saying which of its ends it shares with that joint (0 none, 1 its
 // body, 2 its partner) (3).
 
-// One direct solve of a cut path (a chain: each joint shares one body with the
-// next): the 3D gaps of all its joints closed at once, as the linear system
+// One direct solve of a chain, or of a path cut from a larger island (a
+// chain too: each joint shares one body with the next): the 3D gaps of all its joints closed at once, as the linear system
 // of their pushes (block tridiagonal, 3 x 3 blocks) solved by elimination
 // forward and substitution back. What the Gauss-Seidel sweeps approach along
 // the path in many closes, one pass reaches; the colours' turns still carry
@@ -706,17 +706,17 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
 }
 
 // The joints of path gid.x of this pass's colour, if it is of the kind asked
-// (cut from a larger island, or whole) and its island is awake:
+// (solved directly, or swept) and its island is awake:
 // (first, end) in joint_refs, or (NONE, NONE).
-fn colour_path(gid: vec3<u32>, cut: bool) -> vec2<u32> {
+fn colour_path(gid: vec3<u32>, direct: bool) -> vec2<u32> {
     let path = params.path_first + gid.x;
     if (path >= params.path_end) {
         return vec2<u32>(NONE);
     }
     // path p's joints follow the islands' in joint_start, and after all
-    // paths, each one's closes a solve_joints pass: 0 for a cut path (joint_lists)
+    // paths, each one's closes a solve_joints pass: 0 for a path solved directly (joint_lists)
     let at = params.body_count + params.island_count + 2u + path;
-    if ((joint_start[at + 1u + params.path_count] == 0u) != cut) {
+    if ((joint_start[at + 1u + params.path_count] == 0u) != direct) {
         return vec2<u32>(NONE);
     }
     let first = joint_start[at];
@@ -728,8 +728,8 @@ fn colour_path(gid: vec3<u32>, cut: bool) -> vec2<u32> {
 }
 
 // Pass "solve_paths", twice a substep (after its first solve and its last),
-// once per colour, one invocation per path cut from a larger island: the
-// path solved directly (solve_path).
+// once per colour, one invocation per chain or path cut from a larger
+// island: the path solved directly (solve_path).
 @compute @workgroup_size(PATH_WORKGROUP)
 fn solve_paths(@builtin(global_invocation_id) gid: vec3<u32>) {
     let path = colour_path(gid, true);

@@ -34,7 +34,7 @@ pub enum Buffer {
     IslandRest = 23,
     /// The hull records (src/world/hull_records.rs).
     Hulls = 24,
-    /// `solve_paths`' elimination along the cut paths (`PATH_SLOT` vec4 words a path joint).
+    /// `solve_paths`' elimination along its paths (`PATH_SLOT` vec4 words a path joint).
     PathScratch = 25,
 }
 

@@ -47,8 +47,8 @@ pub(super) struct WorldData {
     /// Each joint island's two words for `joint_rest` (its least rest time
     /// and whether it is held), emptied before each use.
     pub island_rest: wgpu::Buffer,
-    /// `solve_joints`' elimination along the cut paths, a slot a path joint,
-    /// written and read within one pass.
+    /// `solve_paths`' elimination along the paths it solves directly, a
+    /// slot a path joint, written and read within one pass.
     pub path_scratch: wgpu::Buffer,
     /// Working buffers of the passes: vel0, and the grid's cell_count,
     /// cell_start, block_sums, sorted and cell_bounds.
@@ -391,12 +391,12 @@ fn island_rest_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffe
     storage_buffer(device, "joints/island_rest", island_rest_bytes(joints))
 }
 
-/// Bytes of `WorldData::path_scratch`: where some paths are cut from a
-/// larger island, a slot for every joint of the paths (a path's slots
-/// follow its place among them); else one.
+/// Bytes of `WorldData::path_scratch`: where some paths are solved
+/// directly, a slot for every joint of the paths (a path's slots follow its
+/// place among them); else one.
 fn path_scratch_bytes(joints: &JointLists) -> u64 {
-    let (_, cut) = joints.path_kinds();
-    16 * u64::from(PATH_SLOT) * if cut { u64::from(joints.path_joints().max(1)) } else { 1 }
+    let (_, direct) = joints.path_kinds();
+    16 * u64::from(PATH_SLOT) * if direct { u64::from(joints.path_joints().max(1)) } else { 1 }
 }
 
 fn path_scratch_buffer(device: &wgpu::Device, joints: &JointLists) -> wgpu::Buffer {

@@ -192,7 +192,7 @@ impl World {
             let at = sub * per_substep;
             plan.push((Stage::Integrate, at));
             let sweeps = self.settings.sweeps(sub as u32);
-            let (whole, cut) = self.path_kinds;
+            let (swept, direct) = self.path_kinds;
             for sweep in 0..sweeps {
                 plan.extend([(Stage::SolveContacts, at), (Stage::Solve, at)]);
                 if self.island_count > 0 {
@@ -200,13 +200,13 @@ impl World {
                     if sweep == 0 && self.settings.sleeping {
                         plan.extend([Stage::JointRestClear, Stage::JointRestGather, Stage::JointRest].map(|s| (s, at)));
                     }
-                    if whole {
+                    if swept {
                         plan.extend((1..per_substep).map(|c| (Stage::SolveJoints, at + c)));
                     }
-                    // the cut paths twice a substep: after its first sweep and after
-                    // its last, both after a single one (docs/decisions/joints.md)
+                    // the paths solved directly twice a substep: after its first sweep
+                    // and after its last, both after a single one (docs/decisions/joints.md)
                     let rounds = usize::from(sweep == 0) + usize::from(sweep + 1 == sweeps);
-                    if cut {
+                    if direct {
                         for _ in 0..rounds {
                             plan.extend((1..per_substep).map(|c| (Stage::SolvePaths, at + c)));
                         }

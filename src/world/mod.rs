@@ -73,8 +73,8 @@ pub struct World {
     /// Where each colour of the joint paths begins, and after the last its
     /// end (`JointLists::colours`): `solve_joints` and `solve_paths` run once per colour.
     path_colours: Vec<u32>,
-    /// Whether some paths are whole islands (`solve_joints` runs), and
-    /// whether some are cut from larger ones (`solve_paths` runs).
+    /// Whether some paths are swept (`solve_joints` runs), and whether some
+    /// are solved directly (`solve_paths` runs): `JointLists::path_kinds`.
     path_kinds: (bool, bool),
     /// Whether the bodies' speed limits (`BodyProps::speed_limit`, from the
     /// scene's energy) still hold: no input, edit or restore since.

@@ -113,17 +113,18 @@ pub(crate) fn body_output(s: &BodyState, dt: f64, gravity: [f32; 3], not_free: b
 ///   nothing can move them.
 /// - After the islands, the paths `solve_joints` and `solve_paths` solve
 ///   (path p's joints are `refs[starts[n + islands + 2 + p]..]`): every joint once, an
-///   island of at most `PATH_JOINTS` joints as one path in its order (a
-///   chain, a bridge, a ragdoll), a larger one cut into runs of at most
-///   `CUT_PATH_JOINTS` joints that go on through a shared body as nearly
-///   straight as they can, from where the island is held (a hanging grid's
-///   columns, then its rows), each joint seen from the end it shares with
-///   the one before it, so a forward sweep carries a correction along the
-///   path and a backward one back; a cut path never comes back to a body
-///   it holds, so that it is a chain. After the paths' starts, each path's
-///   joint closes a `solve_joints` pass: `u32::MAX` for a whole island (as
-///   many sweeps as the pass asks), 0 for a path cut from a larger one
-///   (`solve_paths` solves it directly, as one system). They come by
+///   island of at most `PATH_JOINTS` joints as one path (a chain along
+///   itself, from its first end in the island's order; an island with a
+///   branch or a loop, a bridge or a ragdoll, in its order), a larger one
+///   cut into runs of at most `CUT_PATH_JOINTS` joints that go on through a
+///   shared body as nearly straight as they can, from where the island is
+///   held (a hanging grid's columns, then its rows). Along a chain or a cut
+///   path each joint is seen from the end it shares with the one before it,
+///   and the path never comes back to a body it holds: it is a chain.
+///   After the paths' starts, each path's joint closes a `solve_joints`
+///   pass: `u32::MAX` for an island with a branch or a loop (swept, as many
+///   sweeps as the pass asks), 0 for a chain or a path cut from a larger
+///   island (`solve_paths` solves it directly, as one system). They come by
 ///   colour: no two paths of one colour share a movable body, so a
 ///   colour's paths are solved side by side, one invocation each, and the
 ///   colours one after the other (Gauss-Seidel between colours).
@@ -136,9 +137,9 @@ pub(crate) struct JointLists {
     pub colours: Vec<u32>,
 }
 
-/// The most joints of an island swept whole as one path (`solve_joints`):
-/// its sweeps out and back stay within the driver's loop limit with room to
-/// spare. A larger island is cut (`CUT_PATH_JOINTS`).
+/// The most joints of an island kept whole as one path: swept
+/// (`solve_joints`), its sweeps out and back stay within the driver's loop
+/// limit with room to spare. A larger island is cut (`CUT_PATH_JOINTS`).
 pub(crate) const PATH_JOINTS: usize = 128;
 
 /// The most joints of a path cut from a larger island: `solve_paths` takes
@@ -164,8 +165,8 @@ impl JointLists {
         self.refs.len() as u32 - self.starts[first]
     }
 
-    /// Whether some paths are whole islands (`solve_joints`), and whether
-    /// some are cut from larger ones (`solve_paths`).
+    /// Whether some paths are swept (`solve_joints`), and whether some are
+    /// solved directly (`solve_paths`).
     pub(crate) fn path_kinds(&self) -> (bool, bool) {
         let paths = self.colours.last().copied().unwrap_or(0) as usize;
         let closes = &self.starts[self.starts.len() - paths..];
@@ -272,10 +273,10 @@ pub(crate) fn joint_lists(scene: &Scene) -> JointLists {
     starts.extend(island_starts);
     let (paths, colours) = joint_paths(scene, &island_order, &touching);
     let mut closes = Vec::with_capacity(paths.len());
-    for (path, whole) in paths {
+    for (path, swept) in paths {
         starts.push(refs.len() as u32);
         refs.extend(path);
-        closes.push(if whole { u32::MAX } else { 0 });
+        closes.push(if swept { u32::MAX } else { 0 });
     }
     starts.push(refs.len() as u32);
     starts.extend(closes);
@@ -330,11 +331,46 @@ pub(crate) fn to_mass_frame(b: &Body, p: [f32; 3]) -> [f32; 3] {
     (axes.conjugate() * (DVec3::from_array(p.map(|v| v as f64)) - centre)).as_vec3().to_array()
 }
 
+/// An island's joints along the chain they form, where they form one: each
+/// movable body in at most two of them and the bodies joined in a line (a
+/// rope, a chain hung by one end or both, a pendulum). From the first end
+/// in the island's order, each joint seen from the body it shares with the
+/// joint before (the first from its movable body), so that `solve_paths`
+/// solves it as one system. None for an island with a branch or a loop.
+fn chain_order(scene: &Scene, island: &[(usize, u32)], touching: &[Vec<usize>]) -> Option<Vec<JointRef>> {
+    let movable = |b: i32| b >= 0 && scene.bodies[b as usize].is_dynamic();
+    let ends = |k: usize| scene.joints[k].bodies;
+    // a joint between two movable bodies, not an anchor
+    let links = |k: usize| ends(k).iter().all(|&b| movable(b));
+    let degree = |b: u32| touching[b as usize].len();
+    let bodies: std::collections::BTreeSet<u32> =
+        island.iter().flat_map(|&(k, _)| ends(k)).filter(|&b| movable(b)).map(|b| b as u32).collect();
+    let link_count = island.iter().filter(|&&(k, _)| links(k)).count();
+    if bodies.iter().any(|&b| degree(b) > 2) || link_count + 1 != bodies.len() {
+        return None;
+    }
+    let link_degree = |b: u32| touching[b as usize].iter().filter(|&&k| links(k)).count();
+    let start = island.iter().map(|&(_, at)| at).find(|&at| link_degree(at) <= 1)?;
+    let end_at = |k: usize, at: u32| joint_end(scene, &scene.joints[k], usize::from(ends(k)[0] != at as i32));
+    let mut path = Vec::with_capacity(island.len());
+    let (mut at, mut came) = (start, usize::MAX);
+    loop {
+        // its anchors, then on along its link not yet taken
+        path.extend(touching[at as usize].iter().filter(|&&k| !links(k)).map(|&k| end_at(k, at)));
+        let Some(&next) = touching[at as usize].iter().find(|&&k| links(k) && k != came) else { break };
+        let r = end_at(next, at);
+        path.push(r);
+        (at, came) = (r.partner, next);
+    }
+    // a line of bodies walked from one end takes every joint once
+    (path.len() == island.len()).then_some(path)
+}
+
 /// The joints cut into coloured paths (see `JointLists`), from the islands'
 /// joints in their order (each joint with the body it is seen from);
 /// `touching`: the joints each movable body takes part in. Returns
-/// the paths in colour order, each with whether it is a whole island, and
-/// where each colour begins.
+/// the paths in colour order, each with whether it is swept (else solved
+/// directly), and where each colour begins.
 fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usize>]) -> (Vec<(Vec<JointRef>, bool)>, Vec<u32>) {
     let movable = |b: u32| b != WORLD && scene.bodies[b as usize].is_dynamic();
     // joint k seen from its end at body `at`
@@ -363,14 +399,17 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         Some((k, r))
     };
     let mut paths: Vec<(Vec<JointRef>, Vec<u32>, bool)> = Vec::new();
-    // an island of at most PATH_JOINTS joints is one path, in its order
-    // (outward from where it is held): a chain, a bridge or a ragdoll is
-    // swept whole, its parallel joints (a bridge's two ropes) together
+    // an island of at most PATH_JOINTS joints is one path: a chain along
+    // itself, solved directly; any other (a bridge's two ropes, a
+    // ragdoll's branches) in its order (outward from where it is held),
+    // swept whole, its parallel joints together
     for island in islands.iter().filter(|i| i.len() <= PATH_JOINTS) {
-        let path: Vec<JointRef> = island.iter().map(|&(k, at)| end_at(k, at)).collect();
+        let chain = chain_order(scene, island, touching);
+        let swept = chain.is_none();
+        let path: Vec<JointRef> = chain.unwrap_or_else(|| island.iter().map(|&(k, at)| end_at(k, at)).collect());
         let bodies = path.iter().flat_map(|r| [r.body, r.partner]).filter(|&b| movable(b)).collect();
         island.iter().for_each(|&(k, _)| taken[k] = true);
-        paths.push((path, bodies, true));
+        paths.push((path, bodies, swept));
     }
     // a larger one is cut into paths, the first ones starting where it is
     // held (a joint to the world or a fixed body), so that they sweep
@@ -671,30 +710,37 @@ mod tests {
         // 4); a body's joints in the scene's order
         assert_eq!(island(0), vec![(2, 1), (2, WORLD), (1, 0)]);
         assert_eq!(island(1), vec![(3, 4)]);
-        // then the paths: each island is one (they are small), in its
-        // order; they share no body, so one colour holds both
+        // then the paths: each island is one (they are small); both are
+        // chains, so each runs along itself from its held end, each joint
+        // seen from the body it shares with the one before, and is solved
+        // directly; they share no body, so one colour holds both
         let path = |p: usize| {
             let at = n + 1 + 2 + 1 + p;
             let (from, to) = (lists.starts[at] as usize, lists.starts[at + 1] as usize);
             lists.refs[from..to].iter().map(|r| (r.body, r.partner)).collect::<Vec<_>>()
         };
-        assert_eq!(path(0), island(0));
+        assert_eq!(path(0), vec![(2, WORLD), (2, 1), (1, 0)]);
         assert_eq!(path(1), vec![(3, 4)]);
         assert_eq!(lists.colours, vec![0, 2]);
         assert_eq!(lists.starts.len(), n + 1 + 3 + 3 + 2);
+        assert_eq!(lists.starts[n + 1 + 3 + 3..], [0, 0]);
+        assert_eq!(lists.path_kinds(), (false, true));
     }
 
     /// Every joint is in one path; no two paths of a colour share a body
     /// that moves; a path follows its joints through shared bodies.
     #[test]
     fn joint_paths_cover_every_joint_and_colours_share_no_body() {
-        for (name, scene) in [
-            ("chain", crate::scenes::chain(21)),
-            ("bridge", crate::scenes::bridge(20)),
-            ("ragdoll", crate::scenes::ragdoll(3)),
-            ("joint_grid", crate::scenes::joint_grid(20)),
-            ("large joint_grid", crate::scenes::joint_grid(100)),
-            ("long chain", crate::scenes::chain(300)),
+        // whether its paths are swept (an island with a branch or a loop)
+        // or solved directly (a chain, or paths cut from a larger island)
+        for (name, scene, swept) in [
+            ("chain", crate::scenes::chain(21), false),
+            ("catenary", crate::scenes::hanging(20), false),
+            ("bridge", crate::scenes::bridge(20), true),
+            ("ragdoll", crate::scenes::ragdoll(3), true),
+            ("joint_grid", crate::scenes::joint_grid(20), false),
+            ("large joint_grid", crate::scenes::joint_grid(100), false),
+            ("long chain", crate::scenes::chain(300), false),
         ] {
             let lists = joint_lists(&scene);
             let n = scene.bodies.len();
@@ -704,17 +750,16 @@ mod tests {
                 lists.starts[first..first + count + 1].windows(2).map(|w| &lists.refs[w[0] as usize..w[1] as usize]).collect();
             let moving = |b: u32| b != WORLD && scene.bodies[b as usize].is_dynamic();
             let solved = scene.joints.iter().filter(|j| j.bodies.iter().any(|&b| b >= 0 && moving(b as u32))).count();
-            // whole islands are swept, paths cut from larger ones solved directly
-            let cut = &lists.starts[first + count + 1..];
-            assert_eq!(cut.len(), count, "{name}");
+            let closes = &lists.starts[first + count + 1..];
+            assert_eq!(closes.len(), count, "{name}");
             let whole = solved <= PATH_JOINTS;
-            assert!(cut.iter().all(|&c| c == if whole { u32::MAX } else { 0 }), "{name}");
-            assert_eq!(lists.path_kinds(), (whole && count > 0, !whole), "{name}");
+            assert!(closes.iter().all(|&c| c == if swept { u32::MAX } else { 0 }), "{name}");
+            assert_eq!(lists.path_kinds(), (swept, !swept), "{name}");
             assert_eq!(paths.iter().map(|p| p.len()).sum::<usize>(), solved, "{name}: every joint once");
             for p in &paths {
                 assert!(p.len() <= if whole { PATH_JOINTS } else { CUT_PATH_JOINTS }, "{name}: a path of {}", p.len());
-                // a large island's paths go on through shared bodies
-                if solved > PATH_JOINTS {
+                // a path solved directly goes on through shared bodies
+                if !swept {
                     for w in p.windows(2) {
                         assert!(w[1].body == w[0].partner || w[1].body == w[0].body, "{name}: a path jumps");
                     }
@@ -722,7 +767,7 @@ mod tests {
                     for (k, r) in p.iter().enumerate() {
                         for later in p.iter().skip(k + 2) {
                             let shares = |b: u32| moving(b) && (b == later.body || b == later.partner);
-                            assert!(!shares(r.body) && !shares(r.partner), "{name}: a cut path comes back to a body");
+                            assert!(!shares(r.body) && !shares(r.partner), "{name}: a direct path comes back to a body");
                         }
                     }
                 }
@@ -743,7 +788,7 @@ mod tests {
         // a chain hung from the world is one path; a large grid's columns
         // are one colour and its rows the other
         assert_eq!(joint_lists(&crate::scenes::chain(21)).colour_count(), 1);
-        // a chain of up to CUT_PATH_JOINTS links is one cut path
+        // so is one of up to CUT_PATH_JOINTS links, cut from nothing
         assert_eq!(joint_lists(&crate::scenes::chain(300)).colour_count(), 1);
         assert_eq!(joint_lists(&crate::scenes::joint_grid(100)).colour_count(), 2);
     }
