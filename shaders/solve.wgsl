@@ -584,9 +584,10 @@ fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
 // body, 2 its partner) (3).
 
 // One direct solve of a chain, or of a path cut from a larger island (a
-// chain too: each joint shares one body with the next): the 3D gaps of all its joints closed at once, as the linear system
-// of their pushes (block tridiagonal, 3 x 3 blocks) solved by elimination
-// forward and substitution back. What the Gauss-Seidel sweeps approach along
+// chain too: each joint shares one body with the next): the 3D gaps of all
+// its joints closed at once, as the linear system of their pushes (block
+// tridiagonal, 3 x 3 blocks) solved by elimination forward and substitution
+// back. What the Gauss-Seidel sweeps approach along
 // the path in many closes, one pass reaches; the colours' turns still carry
 // corrections between paths.
 fn solve_path(first: u32, end: u32, slot0: u32) {
