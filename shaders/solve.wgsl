@@ -340,6 +340,10 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
     return -n * max(overlap - GROUND_DEPTH, 0.0);
 }
 
+// A sweep of a path that closes no joint by more than this (m) leaves the
+// rest of the pass's sweeps nothing to do.
+const JOINT_SETTLED: f32 = 1e-5;
+
 // Pass "solve_joints", after every solve, once per colour of joint paths
 // (joint_lists in src/world/records.rs), one invocation per path of an
 // island with a branch or a loop (of at most 128 joints; solve_paths takes
@@ -352,8 +356,9 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
 // Closes one joint (eq. 9) on the states *sa and *sb of its body and partner
 // (sb unused for a joint to the world): they move along the gap between the
 // anchors, by their generalised inverse masses, and the displacement moves
-// with the pose, as solve's snaps do. Says which of the two it moved.
-fn close_joint(j: JointRef, sa: ptr<function, BodyState>, sb: ptr<function, BodyState>) -> vec2<bool> {
+// with the pose, as solve's snaps do. Says which of the two it moved, and
+// how far it closed the gap in *closed.
+fn close_joint(j: JointRef, sa: ptr<function, BodyState>, sb: ptr<function, BodyState>, closed: ptr<function, f32>) -> vec2<bool> {
     let joined = j.partner != WORLD;
     let pa = props_of(j.body);
     let pb = props_of(select(j.body, j.partner, joined));
@@ -374,8 +379,10 @@ fn close_joint(j: JointRef, sa: ptr<function, BodyState>, sb: ptr<function, Body
     let wa = select(pa.inv_inertia.w + dot(cross(ra, n), turn_a), 0.0, is_fixed(pa));
     let wb = select(0.0, pb.inv_inertia.w + dot(cross(rb, n), turn_b), joined && !is_fixed(pb));
     if (dist <= bounded + 1e-7 || wa + wb <= 0.0) {
+        *closed = 0.0;
         return vec2<bool>(false);
     }
+    *closed = dist - bounded;
     let lambda = (dist - bounded) / (wa + wb);
     if (wa > 0.0) {
         let dx = n * (pa.inv_inertia.w * lambda);
@@ -757,6 +764,9 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     var held = vec2<u32>(NONE);
     var kept: array<BodyState, 2>;
     var moved = vec2<bool>(false);
+    // the most a close of this sweep moved its joint: a sweep that closes
+    // none by more than JOINT_SETTLED ends the pass
+    var widest = 0.0;
     for (var t = 0u; t < 2u * n * sweeps; t = t + 1u) {
         let r = t % (2u * n);
         let j = joint_refs[select(first + r, end - 1u - (r - n), r >= n)];
@@ -771,11 +781,19 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
         var sa = held_or_loaded(a, held, kept);
         var sb = held_or_loaded(b, held, kept);
         let was = vec2<bool>(unwritten(a, held, moved), unwritten(b, held, moved));
-        let now = close_joint(j, &sa, &sb);
+        var closed = 0.0;
+        let now = close_joint(j, &sa, &sb, &closed);
         held = vec2<u32>(a, select(NONE, b, b != a));
         kept[0] = sa;
         kept[1] = sb;
         moved = (was | now) & vec2<bool>(true, b != a);
+        widest = max(widest, closed);
+        if (r + 1u == 2u * n) {
+            if (widest < JOINT_SETTLED) {
+                break;
+            }
+            widest = 0.0;
+        }
     }
     for (var k = 0u; k < 2u; k = k + 1u) {
         if (moved[k]) {

@@ -18,9 +18,11 @@ use crate::Error;
 pub(super) const MAX_BATCH: usize = 64;
 
 /// Gauss-Seidel sweeps over the joints in a substep, spread over its
-/// `solve_joints` passes, one after each relaxation sweep (rounded up). A
-/// chain converges in a few; a bridge pinned taut at both ends and loaded
-/// is the slowest case met (docs/step.md, "Joints").
+/// `solve_joints` passes, one after each relaxation sweep (rounded up), at
+/// most: a path's pass ends at a sweep that closes no joint by more than
+/// `JOINT_SETTLED` (shaders/solve.wgsl). A ragdoll settles in a few; a
+/// bridge pinned taut at both ends and loaded is the slowest case met
+/// (docs/step.md, "Joints").
 pub(crate) const JOINT_SWEEPS_PER_SUBSTEP: u32 = 64;
 
 impl World {
