@@ -727,6 +727,44 @@ mod tests {
         assert_eq!(lists.path_kinds(), (false, true));
     }
 
+    /// Which small islands are chains, solved directly, and which are swept:
+    /// a line of bodies whatever holds it is a chain; a body with a third
+    /// joint, or two bodies joined twice, is not.
+    #[test]
+    fn chains_are_told_from_other_islands() {
+        let kinds = |joints: Vec<Joint>, fixed: &[usize]| {
+            let mut scene = stack(0);
+            scene.bodies = (0..5).map(|k| box_body([0.5; 3], [k as f32, 1.0, 0.0])).collect();
+            for &f in fixed {
+                scene.bodies[f].fixed = true;
+            }
+            scene.joints = joints;
+            let lists = joint_lists(&scene);
+            let paths = *lists.colours.last().unwrap() as usize;
+            let n = scene.bodies.len() + 2 + lists.islands as usize;
+            let path = |p: usize| {
+                let (from, to) = (lists.starts[n + p] as usize, lists.starts[n + p + 1] as usize);
+                lists.refs[from..to].iter().map(|r| (r.body, r.partner)).collect::<Vec<_>>()
+            };
+            (lists.starts[lists.starts.len() - paths..].to_vec(), (0..paths).map(path).collect::<Vec<_>>())
+        };
+        let j = |a: i32, b: i32| Joint { bodies: [a, b], anchors: [[0.5, 0.0, 0.0], [-0.5, 0.0, 0.0]] };
+        let world = |a: i32| Joint { bodies: [a, -1], anchors: [[0.0, 0.5, 0.0], [a as f32, 1.5, 0.0]] };
+        // a line hung from a fixed body at one end and the world at the
+        // other, listed out of order: one path along it from the held end
+        let (closes, paths) = kinds(vec![j(2, 3), j(0, 1), world(3), j(1, 2)], &[0]);
+        assert_eq!(closes, [0]);
+        assert_eq!(paths, [vec![(1, 0), (1, 2), (2, 3), (3, WORLD)]]);
+        // two free bodies on one joint, and a body held twice by the world
+        let (closes, paths) = kinds(vec![j(0, 1), world(3), world(3)], &[]);
+        assert_eq!(closes, [0, 0]);
+        assert!(paths.contains(&vec![(3, WORLD), (3, WORLD)]) && paths.contains(&vec![(0, 1)]));
+        // a body with three joints (a branch), and two bodies joined twice (a loop)
+        assert_eq!(kinds(vec![j(0, 1), j(1, 2), j(1, 3)], &[]).0, [u32::MAX]);
+        assert_eq!(kinds(vec![j(0, 1), world(1), j(1, 2)], &[]).0, [u32::MAX]);
+        assert_eq!(kinds(vec![j(0, 1), j(0, 1)], &[]).0, [u32::MAX]);
+    }
+
     /// Every joint is in one path; no two paths of a colour share a body
     /// that moves; a path follows its joints through shared bodies.
     #[test]
