@@ -332,8 +332,9 @@ pub(crate) fn to_mass_frame(b: &Body, p: [f32; 3]) -> [f32; 3] {
 }
 
 /// An island's joints along the chain they form, where they form one: each
-/// movable body in at most two of them and the bodies joined in a line (a
-/// rope, a chain hung by one end or both, a pendulum). From the first end
+/// movable body in at most two of them and held by at most one, and the
+/// bodies joined in a line (a rope, a chain hung by one end or both, a
+/// pendulum). From the first end
 /// in the island's order, each joint seen from the body it shares with the
 /// joint before (the first from its movable body), so that `solve_paths`
 /// solves it as one system. None for an island with a branch or a loop.
@@ -346,10 +347,13 @@ fn chain_order(scene: &Scene, island: &[(usize, u32)], touching: &[Vec<usize>]) 
     let bodies: std::collections::BTreeSet<u32> =
         island.iter().flat_map(|&(k, _)| ends(k)).filter(|&b| movable(b)).map(|b| b as u32).collect();
     let link_count = island.iter().filter(|&&(k, _)| links(k)).count();
-    if bodies.iter().any(|&b| degree(b) > 2) || link_count + 1 != bodies.len() {
+    let link_degree = |b: u32| touching[b as usize].iter().filter(|&&k| links(k)).count();
+    // a body held at two points (a door on two hinges) turns about the line
+    // between them however it is pushed: its two joints' system is singular
+    let held_twice = |b: u32| degree(b) - link_degree(b) > 1;
+    if bodies.iter().any(|&b| degree(b) > 2 || held_twice(b)) || link_count + 1 != bodies.len() {
         return None;
     }
-    let link_degree = |b: u32| touching[b as usize].iter().filter(|&&k| links(k)).count();
     let start = island.iter().map(|&(_, at)| at).find(|&at| link_degree(at) <= 1)?;
     let end_at = |k: usize, at: u32| joint_end(scene, &scene.joints[k], usize::from(ends(k)[0] != at as i32));
     let mut path = Vec::with_capacity(island.len());
@@ -378,7 +382,10 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
     let mut taken = vec![false; scene.joints.len()];
     // the joint at body `at` (a movable one) not yet taken that goes on most
     // nearly straight from `from` (where, in its frame, the path came in;
-    // the first listed among equals), taken, seen from `at`
+    // the first listed among equals) to another movable body, taken, seen
+    // from `at`: a joint to the world or a fixed body only starts a path, so
+    // that no path holds a body at two points (its system is singular, as
+    // `chain_order` says)
     let straightest = |at: u32, from: [f32; 3], taken: &mut Vec<bool>| -> Option<(usize, JointRef)> {
         if !movable(at) {
             return None;
@@ -388,7 +395,8 @@ fn joint_paths(scene: &Scene, islands: &[Vec<(usize, u32)>], touching: &[Vec<usi
         let mut best: Option<(usize, JointRef)> = None;
         // a turn of a right angle or more ends the path: a grid's columns
         // and rows stay apart, so that two colours hold them
-        let ahead = touching[at as usize].iter().filter(|&&k| !taken[k]).map(|&k| (k, end_at(k, at)));
+        let ahead =
+            touching[at as usize].iter().filter(|&&k| !taken[k]).map(|&k| (k, end_at(k, at))).filter(|(_, r)| movable(r.partner));
         for (k, r) in ahead.filter(|(_, r)| straight(r) > 0.0 || came == glam::Vec3::ZERO) {
             if best.as_ref().is_none_or(|(_, b)| straight(&r) > straight(b)) {
                 best = Some((k, r));
@@ -755,10 +763,11 @@ mod tests {
         let (closes, paths) = kinds(vec![j(2, 3), j(0, 1), world(3), j(1, 2)], &[0]);
         assert_eq!(closes, [0]);
         assert_eq!(paths, [vec![(1, 0), (1, 2), (2, 3), (3, WORLD)]]);
-        // two free bodies on one joint, and a body held twice by the world
+        // two free bodies on one joint; a body held at two points by the
+        // world (a door on two hinges: their system is singular) is swept
         let (closes, paths) = kinds(vec![j(0, 1), world(3), world(3)], &[]);
-        assert_eq!(closes, [0, 0]);
-        assert!(paths.contains(&vec![(3, WORLD), (3, WORLD)]) && paths.contains(&vec![(0, 1)]));
+        assert_eq!(closes, [u32::MAX, 0]);
+        assert_eq!(paths, [vec![(3, WORLD), (3, WORLD)], vec![(0, 1)]]);
         // a body with three joints (a branch), and two bodies joined twice (a loop)
         assert_eq!(kinds(vec![j(0, 1), j(1, 2), j(1, 3)], &[]).0, [u32::MAX]);
         assert_eq!(kinds(vec![j(0, 1), world(1), j(1, 2)], &[]).0, [u32::MAX]);
