@@ -594,9 +594,10 @@ fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
 // chain too: each joint shares one body with the next): the 3D gaps of all
 // its joints closed at once, as the linear system of their pushes (block
 // tridiagonal, 3 x 3 blocks) solved by elimination forward and substitution
-// back. What the Gauss-Seidel sweeps approach along
-// the path in many closes, one pass reaches; the colours' turns still carry
-// corrections between paths.
+// back. What the Gauss-Seidel sweeps approach along the path in many
+// closes, one pass reaches; the colours' turns still carry corrections
+// between paths. Such a chain is held at one point at most (joint_lists),
+// so its system is never singular.
 fn solve_path(first: u32, end: u32, slot0: u32) {
     let n = end - first;
     var held: array<PathEnd, 2>;
