@@ -1,8 +1,9 @@
 // Passes "solve_contacts", "solve", "joint_rest", "solve_joints" and
 // "solve_paths", run in each substep its share of `iterations` times
 // (solve_paths twice): the paper's corrective snaps (eqs. 9-10). Contacts are
-// relaxed Jacobi style from state_in: solve_contacts (per manifold) writes what a pair's points ask of each body (two EndSnaps),
-// and solve (per listed body with contacts) sums them in pair order, relaxes
+// relaxed Jacobi style from state_in: solve_contacts (per manifold) writes
+// what a pair's points ask of each body (two EndSnaps), and solve (per
+// listed body with contacts) sums them in pair order, relaxes
 // the sum by c_r and moves its own pose in place (bound as state_out: every
 // snap was measured in the pass before). All of a body's snaps are measured on
 // one pose, so symmetric contacts cancel and no sum depends on thread timing.
@@ -353,6 +354,35 @@ const JOINT_SETTLED: f32 = 1e-5;
 // all the way. No two paths of a colour share a body that moves, and a path's
 // order is fixed, so nothing depends on thread timing. See docs/decisions/joints.md.
 
+// A joint's world anchors' offsets from its ends' centres, ra then rb (nil
+// for a joint to the world), at the orientations rot_a and rot_b.
+fn joint_anchors(j: JointRef, rot_a: vec4<f32>, rot_b: vec4<f32>) -> array<vec3<f32>, 2> {
+    return array<vec3<f32>, 2>(quat_rotate(rot_a, j.local_self),
+                               select(vec3<f32>(0.0), quat_rotate(rot_b, j.local_partner), j.partner != WORLD));
+}
+
+// A joint's anchors' offsets, its gap from a's anchor to b's and that gap's
+// length, and how much of it may stay open this substep (`bounded`): the gap
+// at the previous poses closes at no more than MAX_DEPENETRATION_SPEED (a
+// full snap becomes velocity); what this substep opened closes whole.
+struct JointGap {
+    ra: vec3<f32>,
+    rb: vec3<f32>,
+    gap: vec3<f32>,
+    dist: f32,
+    bounded: f32,
+}
+
+fn joint_gap(j: JointRef, sa: BodyState, sb: BodyState) -> JointGap {
+    let joined = j.partner != WORLD;
+    let r = joint_anchors(j, sa.rot, sb.rot);
+    let gap = select(j.local_partner, sb.pos + r[1], joined) - (sa.pos + r[0]);
+    let moved_a = sa.disp + (r[0] - quat_rotate(sa.prev_rot, j.local_self));
+    let moved_b = select(vec3<f32>(0.0), sb.disp + (r[1] - quat_rotate(sb.prev_rot, j.local_partner)), joined);
+    let before = length(gap - (moved_b - moved_a));
+    return JointGap(r[0], r[1], gap, length(gap), max(before - MAX_DEPENETRATION_SPEED * params.dt, 0.0));
+}
+
 // Closes one joint (eq. 9) on the states *sa and *sb of its body and partner
 // (sb unused for a joint to the world): they move along the gap between the
 // anchors, by their generalised inverse masses, and the displacement moves
@@ -362,17 +392,12 @@ fn close_joint(j: JointRef, sa: ptr<function, BodyState>, sb: ptr<function, Body
     let joined = j.partner != WORLD;
     let pa = props_of(j.body);
     let pb = props_of(select(j.body, j.partner, joined));
-    let ra = quat_rotate((*sa).rot, j.local_self);
-    let rb = quat_rotate((*sb).rot, j.local_partner);
-    let gap = select(j.local_partner, (*sb).pos + rb, joined) - ((*sa).pos + ra);
-    let dist = length(gap);
-    // the gap at the previous poses closes at no more than MAX_DEPENETRATION_SPEED
-    // (a full snap becomes velocity); what this substep opened closes whole
-    let moved_a = (*sa).disp + (ra - quat_rotate((*sa).prev_rot, j.local_self));
-    let moved_b = select(vec3<f32>(0.0), (*sb).disp + (rb - quat_rotate((*sb).prev_rot, j.local_partner)), joined);
-    let before = length(gap - (moved_b - moved_a));
-    let bounded = max(before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
-    let n = gap / max(dist, 1e-30); // a moves along n, b against it
+    let g = joint_gap(j, *sa, *sb);
+    let ra = g.ra;
+    let rb = g.rb;
+    let dist = g.dist;
+    let bounded = g.bounded;
+    let n = g.gap / max(dist, 1e-30); // a moves along n, b against it
     // each end's turn per unit push along n, found once for its mass and its move
     let turn_a = inv_inertia_world((*sa).rot, pa.inv_inertia.xyz, cross(ra, n));
     let turn_b = inv_inertia_world((*sb).rot, pb.inv_inertia.xyz, cross(rb, n));
@@ -556,33 +581,17 @@ fn inverse3(m: mat3x3<f32>) -> mat3x3<f32> {
 }
 
 // A joint's world anchors' offsets from its ends' centres, and the part of its
-// gap to close: all of what this substep opened, the old gap at no more than
-// MAX_DEPENETRATION_SPEED (as close_joint).
+// gap to close (joint_gap's, less what may stay open), as close_joint closes it.
 struct PathJoint {
     ra: vec3<f32>,
     rb: vec3<f32>,
     close: vec3<f32>,
 }
 
-// The offsets alone: ra, then rb.
-fn path_anchors(j: JointRef, a: PathEnd, b: PathEnd) -> array<vec3<f32>, 2> {
-    return array<vec3<f32>, 2>(quat_rotate(a.s.rot, j.local_self),
-                               select(vec3<f32>(0.0), quat_rotate(b.s.rot, j.local_partner), j.partner != WORLD));
-}
-
 fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
-    let joined = j.partner != WORLD;
-    let r = path_anchors(j, a, b);
-    let ra = r[0];
-    let rb = r[1];
-    let gap = select(j.local_partner, b.s.pos + rb, joined) - (a.s.pos + ra);
-    let dist = length(gap);
-    let moved_a = a.s.disp + (ra - quat_rotate(a.s.prev_rot, j.local_self));
-    let moved_b = select(vec3<f32>(0.0), b.s.disp + (rb - quat_rotate(b.s.prev_rot, j.local_partner)), joined);
-    let before = length(gap - (moved_b - moved_a));
-    let bounded = max(before - MAX_DEPENETRATION_SPEED * params.dt, 0.0);
-    let part = select(1.0 - bounded / max(dist, 1e-30), 0.0, dist <= bounded + 1e-7);
-    return PathJoint(ra, rb, gap * part);
+    let g = joint_gap(j, a.s, b.s);
+    let part = select(1.0 - g.bounded / max(g.dist, 1e-30), 0.0, g.dist <= g.bounded + 1e-7);
+    return PathJoint(g.ra, g.rb, g.gap * part);
 }
 
 // A joint's PATH_SLOT words of path_scratch: its pivot's inverse, the
@@ -676,7 +685,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         kept[1].i = NONE;
         let a = path_end(j.body, kept);
         let b = path_end(j.partner, kept);
-        let r = path_anchors(j, a, b);
+        let r = joint_anchors(j, a.s.rot, b.s.rot);
         // the body the joint after left waiting, before this joint's end takes its place
         let waited = wait.i;
         let waited_push = wait_push;

@@ -125,8 +125,8 @@ pub struct Params {
     /// The paths of this `solve_joints` or `solve_paths` pass's colour: `path_first..path_end`.
     pub path_first: u32,
     pub path_end: u32,
-    /// The paths of every colour (their budgets follow their starts in
-    /// `joint_start`).
+    /// The paths of every colour (whether each is swept or solved directly
+    /// follows their starts in `joint_start`).
     pub path_count: u32,
     pub _pad1: u32,
 }
