@@ -342,7 +342,8 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
 }
 
 // A sweep of a path that closes no joint by more than this (m) leaves the
-// rest of the pass's sweeps nothing to do.
+// rest of the pass's sweeps nothing to do, and a path solved directly whose
+// joints are all this near closed is left as it is (path_settled).
 const JOINT_SETTLED: f32 = 1e-5;
 
 // Pass "solve_joints", after every solve, once per colour of joint paths
@@ -588,8 +589,8 @@ struct PathJoint {
     close: vec3<f32>,
 }
 
-fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
-    let g = joint_gap(j, a.s, b.s);
+fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
+    let g = joint_gap(j, sa, sb);
     let part = select(1.0 - g.bounded / max(g.dist, 1e-30), 0.0, g.dist <= g.bounded + 1e-7);
     return PathJoint(g.ra, g.rb, g.gap * part);
 }
@@ -598,6 +599,19 @@ fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
 // eliminated gap in the w's (3); its coupling to the joint before, the first
 // word's w saying which of its ends it shares with that joint (0 none, 1 its
 // body, 2 its partner) (3).
+
+// Whether every joint of a path is closed within JOINT_SETTLED, as the
+// swept passes end: its solve would move nothing that matters. Most solves
+// of a path the other colour barely moved are skipped (the joint grid: half).
+fn path_settled(first: u32, end: u32) -> bool {
+    var widest = 0.0;
+    for (var k = first; k < end; k = k + 1u) {
+        let j = joint_refs[k];
+        let pj = path_joint(j, out_state(j.body), out_state(select(j.body, j.partner, j.partner != WORLD)));
+        widest = max(widest, length(pj.close));
+    }
+    return widest < JOINT_SETTLED;
+}
 
 // One direct solve of a chain, or of a path cut from a larger island (a
 // chain too: each joint shares one body with the next): the 3D gaps of all
@@ -609,6 +623,9 @@ fn path_joint(j: JointRef, a: PathEnd, b: PathEnd) -> PathJoint {
 // so its system is never singular.
 fn solve_path(first: u32, end: u32, slot0: u32) {
     let n = end - first;
+    if (path_settled(first, end)) {
+        return;
+    }
     var held: array<PathEnd, 2>;
     held[0].i = NONE;
     held[1].i = NONE;
@@ -619,7 +636,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         let j = joint_refs[first + k];
         let a = path_end(j.body, held);
         let b = path_end(j.partner, held);
-        let pj = path_joint(j, a, b);
+        let pj = path_joint(j, a.s, b.s);
         var m = end_response(a, pj.ra, pj.ra) + end_response(b, pj.rb, pj.rb);
         // the body this joint shares with the one before (x: which end here, y: there)
         var link = vec2<u32>(0u);

@@ -334,9 +334,12 @@ fn a_chain_island_swinging_down_stays_closed() {
 
 /// A net of 30 x 30 balls on ball joints (one island, solved as cut paths)
 /// dropped flat from 3 m onto two layers of boxes drapes over them and holds
-/// together: contacts push its balls while its paths pull them back.
-/// Measured after 600 steps: the widest gap 30.5 mm (72 mm when the paths
-/// were swept Gauss-Seidel style; the balls, 268 kg, press on 50 kg boxes).
+/// together: contacts push its balls while its paths pull them back. Where
+/// balls are caught between boxes (268 kg balls on 50 kg boxes) the widest
+/// gap comes and goes from step to step, so it is taken every 50 steps from
+/// the 300th to the 900th. Measured: at most 49.3 mm, the mean gap at most
+/// 1.75 mm (48.6 and 1.90 mm with every direct path solved whatever its
+/// gaps: a single step's widest gap ranges from 20 to 49 mm either way).
 #[test]
 fn a_net_dropped_on_boxes_holds_together() {
     let mut scene = scenes::joint_grid(30);
@@ -359,10 +362,17 @@ fn a_net_dropped_on_boxes_holds_together() {
         }
     }
     let Some(mut w) = world(&scene) else { return };
-    w.step(600).unwrap();
-    let widest = joint_gaps(&scene, &w.read_raw().unwrap()).into_iter().fold(0.0, f32::max);
-    eprintln!("a net dropped on boxes: widest gap {:.2} mm after 600 steps", widest * 1e3);
-    assert!(widest < 0.045, "a joint opened {widest} m");
+    w.step(300).unwrap();
+    let (mut widest, mut mean) = (0.0f32, 0.0f32);
+    for _ in 0..=12 {
+        let gaps = joint_gaps(&scene, &w.read_raw().unwrap());
+        widest = widest.max(gaps.iter().copied().fold(0.0, f32::max));
+        mean = mean.max(gaps.iter().sum::<f32>() / gaps.len() as f32);
+        w.step(50).unwrap();
+    }
+    eprintln!("a net dropped on boxes, steps 300 to 900: widest gap {:.2} mm, mean at most {:.3} mm", widest * 1e3, mean * 1e3);
+    assert!(widest < 0.055, "a joint opened {widest} m");
+    assert!(mean < 0.002, "the joints opened {mean} m on average");
 }
 
 /// The fastest body over `steps` steps (m/s), and the widest joint gap at the end.
