@@ -601,16 +601,22 @@ fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
 // body, 2 its partner) (3).
 
 // Whether every joint of a path is closed within JOINT_SETTLED, as the
-// swept passes end: its solve would move nothing that matters. Most solves
-// of a path the other colour barely moved are skipped (the joint grid: half).
+// swept passes end, or within what its ends' f32 positions can tell apart
+// (two steps of their largest coordinate's spacing: 15 um 64 to 128 m out):
+// its solve would move nothing that matters. A path the other colour barely
+// moved is mostly skipped so (the joint grid: two solves in three).
 fn path_settled(first: u32, end: u32) -> bool {
-    var widest = 0.0;
+    var settled = true;
     for (var k = first; k < end; k = k + 1u) {
         let j = joint_refs[k];
-        let pj = path_joint(j, out_state(j.body), out_state(select(j.body, j.partner, j.partner != WORLD)));
-        widest = max(widest, length(pj.close));
+        let sa = out_state(j.body);
+        let sb = out_state(select(j.body, j.partner, j.partner != WORLD));
+        // remainder_unit is 1/512 of a coordinate's spacing
+        let unit = max(remainder_unit(sa.pos), remainder_unit(sb.pos));
+        let rounding = 1024.0 * max(unit.x, max(unit.y, unit.z));
+        settled = settled && length(path_joint(j, sa, sb).close) < JOINT_SETTLED + rounding;
     }
-    return widest < JOINT_SETTLED;
+    return settled;
 }
 
 // One direct solve of a chain, or of a path cut from a larger island (a
