@@ -606,7 +606,6 @@ fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
 // its solve would move nothing that matters. A path the other colour barely
 // moved is mostly skipped so (the joint grid: two solves in three).
 fn path_settled(first: u32, end: u32) -> bool {
-    var settled = true;
     for (var k = first; k < end; k = k + 1u) {
         let j = joint_refs[k];
         let sa = out_state(j.body);
@@ -614,9 +613,11 @@ fn path_settled(first: u32, end: u32) -> bool {
         // remainder_unit is 1/512 of a coordinate's spacing
         let unit = max(remainder_unit(sa.pos), remainder_unit(sb.pos));
         let rounding = 1024.0 * max(unit.x, max(unit.y, unit.z));
-        settled = settled && length(path_joint(j, sa, sb).close) < JOINT_SETTLED + rounding;
+        if (length(path_joint(j, sa, sb).close) >= JOINT_SETTLED + rounding) {
+            return false;
+        }
     }
-    return settled;
+    return true;
 }
 
 // One direct solve of a chain, or of a path cut from a larger island (a
