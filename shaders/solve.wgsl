@@ -343,7 +343,8 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
 
 // A sweep of a path that closes no joint by more than this (m) leaves the
 // rest of the pass's sweeps nothing to do, and a path solved directly whose
-// joints are all this near closed is left as it is (path_settled).
+// joints are all this near closed (or as near as rounding allows) is left
+// as it is (path_settled).
 const JOINT_SETTLED: f32 = 1e-5;
 
 // Pass "solve_joints", after every solve, once per colour of joint paths
@@ -603,8 +604,8 @@ fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
 // Whether every joint of a path is closed within JOINT_SETTLED, as the
 // swept passes end, or within what its ends' f32 positions can tell apart
 // (two steps of their largest coordinate's spacing: 15 um 64 to 128 m out):
-// its solve would move nothing that matters. A path the other colour barely
-// moved is mostly skipped so (the joint grid: two solves in three).
+// its solve would move nothing that matters. Most solves of a path the other
+// colour barely moved, or that the substep's first solve left closed, end here.
 fn path_settled(first: u32, end: u32) -> bool {
     for (var k = first; k < end; k = k + 1u) {
         let j = joint_refs[k];
