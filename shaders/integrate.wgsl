@@ -167,7 +167,9 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     } else if (select(false, jittering, params.sleep_after > 0.0)) {
         rest = max(s.rest_time - dt, 0.0);
     }
-    if (rest >= params.sleep_after && rest > 0.0) {
+    // a jointed body falls asleep only where its island's rest time was just
+    // shared (joint_rest runs in a step's first substep alone)
+    if (rest >= params.sleep_after && rest > 0.0 && (!jointed || params.substep == 0u || asleep(s))) {
         // asleep: held still where it is (resting on what pressed it)
         set_state(i, BodyState(s.pos, rest, vec3<f32>(0.0), (s.pos_low & ~WAKES) | HELD | wakes, s.rot, s.rot));
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));

@@ -426,9 +426,10 @@ fn close_joint(j: JointRef, sa: ptr<function, BodyState>, sb: ptr<function, Body
     return vec2<bool>(wa > 0.0, wb > 0.0);
 }
 
-// Passes "joint_rest_clear", "joint_rest_gather" and "joint_rest", once a
-// substep after its first solve, where bodies sleep: an island sleeps and
-// wakes as one. Every body takes the island's least rest time, or none if
+// Passes "joint_rest_clear", "joint_rest_gather" and "joint_rest", in a
+// step's first substep after its first solve, where bodies sleep: an island
+// sleeps and wakes as one (a jointed body falls asleep only in that substep,
+// see integrate, so the later ones find its island's bodies alike). Every body takes the island's least rest time, or none if
 // nothing holds the island up (no contact presses it, no joint to the world
 // or a fixed body). The island's least time and whether it is held are
 // gathered over its joints, one invocation each, with integer atomics (a

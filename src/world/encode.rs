@@ -199,7 +199,7 @@ impl World {
                 plan.extend([(Stage::SolveContacts, at), (Stage::Solve, at)]);
                 if self.island_count > 0 {
                     // islands sleep as one only where bodies sleep at all
-                    if sweep == 0 && self.settings.sleeping {
+                    if sub == 0 && sweep == 0 && self.settings.sleeping {
                         plan.extend([Stage::JointRestClear, Stage::JointRestGather, Stage::JointRest].map(|s| (s, at)));
                     }
                     if swept {
