@@ -198,7 +198,8 @@ impl World {
             for sweep in 0..sweeps {
                 plan.extend([(Stage::SolveContacts, at), (Stage::Solve, at)]);
                 if self.island_count > 0 {
-                    // islands sleep as one only where bodies sleep at all
+                    // islands sleep as one only where bodies sleep at all, shared in a
+                    // step's first substep (integrate lets a jointed body fall asleep there alone)
                     if sub == 0 && sweep == 0 && self.settings.sleeping {
                         plan.extend([Stage::JointRestClear, Stage::JointRestGather, Stage::JointRest].map(|s| (s, at)));
                     }
