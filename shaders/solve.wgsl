@@ -429,9 +429,9 @@ fn close_joint(j: JointRef, sa: ptr<function, BodyState>, sb: ptr<function, Body
 // Passes "joint_rest_clear", "joint_rest_gather" and "joint_rest", in a
 // step's first substep after its first solve, where bodies sleep: an island
 // sleeps and wakes as one (a jointed body falls asleep only in that substep,
-// see integrate, so the later ones find its island's bodies alike). Every body takes the island's least rest time, or none if
-// nothing holds the island up (no contact presses it, no joint to the world
-// or a fixed body). The island's least time and whether it is held are
+// see integrate, so the later ones find its island's bodies alike). Every
+// body takes the island's least rest time, or none if nothing holds the
+// island up (no contact presses it, no joint to the world or a fixed body). The island's least time and whether it is held are
 // gathered over its joints, one invocation each, with integer atomics (a
 // minimum and an or: the same result in any order), so no invocation reads
 // a whole island and an island may be as large as a scene.

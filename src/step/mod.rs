@@ -11,7 +11,7 @@
 //! 5. `solve_contacts`, `solve`, `joint_rest_*`, `solve_joints`, `solve_paths` — the
 //!    substep's share of the `iterations` sweeps of corrective snaps: per manifold what it
 //!    asks of its bodies, then per body the sum (Jacobi), then (only in scenes with joints;
-//!    `joint_rest` once a substep) per colour of joint paths the joints of each island with
+//!    `joint_rest` in a step's first substep) per colour of joint paths the joints of each island with
 //!    a branch or a loop in turn (Gauss-Seidel), and after the substep's first and last
 //!    sweeps each chain, or path cut from a larger island, solved directly
 //!    (shaders/solve.wgsl)
