@@ -10,5 +10,6 @@ mod cli_doorstep;
 mod cli_frames;
 mod cli_hostile;
 mod cli_info;
+mod cli_lavapipe;
 mod cli_run;
 mod cli_scene;

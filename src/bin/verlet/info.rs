@@ -41,7 +41,9 @@ pub fn info() -> Result<(), Error> {
             std::env::var("LP_NUM_THREADS").map_or("LP_NUM_THREADS unset: its default".into(), |t| format!("LP_NUM_THREADS={t}"));
         outln!(
             "software adapter:           lavapipe's worker threads take each dispatch ({threads}); \
-             LP_NUM_THREADS=0 runs them on the submitting thread, faster for scenes of up to a few hundred bodies"
+             LP_NUM_THREADS=0 runs them on the submitting thread, faster for scenes of up to a few hundred bodies \
+             (unset, `verlet run` and `verlet bench` choose it for scenes of at most {} bodies)",
+            crate::lavapipe::INLINE_MAX_BODIES
         )?;
     }
     Ok(())

@@ -37,6 +37,7 @@ macro_rules! eprintln {
 mod bench;
 mod cli;
 mod info;
+mod lavapipe;
 mod paths;
 mod record;
 mod run;

@@ -13,7 +13,7 @@ use verlet::{scenes, BodyOutput, Error, Scene, World};
 
 use crate::cli::RunArgs;
 use crate::record::{self, Recorder};
-use crate::{paths, scene};
+use crate::{lavapipe, paths, scene};
 
 /// `verlet run`: every flag and input checked before the GPU is touched
 /// (a built-in scene's size before it is built), then the world made,
@@ -34,7 +34,10 @@ pub fn run(mut args: RunArgs) -> Result<(), Error> {
     record::check_outputs(&args)?;
     record::warn_stale_frames(&args);
 
-    let gpu = Arc::new(Gpu::new()?);
+    // before any thread starts (the progress bar's): `lavapipe::open` may set
+    // the environment while it opens the adapter
+    let (gpu, dispatch) = lavapipe::open(body_count)?;
+    let gpu = Arc::new(gpu);
     let started = Instant::now();
     let scene = match file_scene {
         Some(scene) => scene,
@@ -59,7 +62,7 @@ pub fn run(mut args: RunArgs) -> Result<(), Error> {
     };
     let frames = recorder.frame_counts();
     write_outputs(&args, recorder, &world, &bodies, scene.settings.dt)?;
-    print_times(&args, &world, &gpu, (bodies.len(), scene.settings.dt), Timings { setup, wall, stages })?;
+    print_times(&args, &world, &gpu, (bodies.len(), scene.settings.dt), Timings { setup, wall, stages, dispatch })?;
     print_recorded(&args, frames)?;
     report_contacts(&args, &world, &gpu)?;
     print_motion(&bodies)?;
@@ -332,6 +335,8 @@ struct Timings {
     setup: Duration,
     wall: Duration,
     stages: Option<StageTotals>,
+    /// Where lavapipe ran the dispatches.
+    dispatch: lavapipe::Dispatch,
 }
 
 /// The summary's first lines: the bodies and steps of `dt` run, on what,
@@ -351,6 +356,9 @@ fn print_times(args: &RunArgs, world: &World, gpu: &Gpu, (bodies, dt): (usize, f
         gpu.describe()
     )?;
     outln!("set-up {:.2} s, stepping {:.2} s ({pace}, wall clock)", t.setup.as_secs_f64(), t.wall.as_secs_f64())?;
+    if let Some(line) = t.dispatch.describe() {
+        outln!("lavapipe: {line}")?;
+    }
     if let Some((stage_ms, timed_by_gpu)) = t.stages {
         let source = if timed_by_gpu { "GPU timestamps" } else { "wall clock per pass" };
         outln!("per stage, ms/step ({source}):")?;

@@ -53,10 +53,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use verlet::bench::{Case, CASES, QUICK_CASES};
-use verlet::gpu::Gpu;
-use verlet::{world, Error};
+use verlet::{scenes, world, Error};
 
 use crate::cli::BenchArgs;
+use crate::lavapipe::{self, Dispatch, INLINE_MAX_BODIES};
 use crate::paths;
 use case::run_case;
 use extras::{cold_start, dispatch_cost, render_cubes, settle};
@@ -221,8 +221,16 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     paths::check_distinct(&[], &outputs)?;
 
     let started = Instant::now();
-    let gpu = Arc::new(Gpu::new()?);
+    // both adapters before any thread starts (the peer's pools): `lavapipe::open`
+    // may set the environment while it opens one
+    let (gpu, workers) = lavapipe::open(u64::MAX)?;
+    let gpu = Arc::new(gpu);
     let gpu_open_s = started.elapsed().as_secs_f64();
+    let small = |case: &Case| scenes::body_count(&case.scene, case.count).is_some_and(|n| n <= INLINE_MAX_BODIES);
+    let inline = match cases.iter().any(small) {
+        true => Some(lavapipe::open(0)?).filter(|(_, d)| *d == Dispatch::Inline).map(|(g, d)| (Arc::new(g), d)),
+        false => None,
+    };
     let max = world::max_bodies(&gpu);
     let timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
     progress!("bench: {} (up to {steps} steps, at most {body_steps} body-steps, x {reps} reps per case)", gpu.describe());
@@ -233,7 +241,12 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     let mut results = Vec::new();
     for case in &cases {
         let before = load_avg();
-        let mut r = run_case(&gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
+        let (case_gpu, dispatch) = match &inline {
+            Some((g, d)) if small(case) => (g, *d),
+            _ => (&gpu, workers),
+        };
+        let mut r = run_case(case_gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
+        r.dispatch = (dispatch != Dispatch::AsSet).then_some(dispatch);
         r.load_avg = before.zip(load_avg()).map(|(a, b)| [a, b]);
         results.push(r);
     }

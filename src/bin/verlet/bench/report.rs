@@ -2,6 +2,7 @@
 
 use super::median;
 use super::results::{CaseResult, PeerResult, Report};
+use crate::lavapipe::{Dispatch, INLINE_MAX_BODIES};
 
 /// The peer's time over ours for each of our repetitions and the peer's
 /// taken right after it (`PeerReps`), when there are several: how far the
@@ -104,6 +105,15 @@ pub fn table(r: &Report) -> String {
     let _ = writeln!(s, "peer:     {}", r.peer);
     let _ = writeln!(s, "solver:   {}", r.iterations);
     let _ = writeln!(s, "command:  {}", r.command);
+    let inline: Vec<&str> = r.cases.iter().filter(|c| c.dispatch == Some(Dispatch::Inline)).map(|c| c.case.as_str()).collect();
+    if !inline.is_empty() {
+        let _ = writeln!(
+            s,
+            "lavapipe: {} ran each dispatch on the submitting thread (at most {} bodies), the other cases on lavapipe's worker threads; LP_NUM_THREADS, when set, decides for all",
+            inline.join(", "),
+            INLINE_MAX_BODIES
+        );
+    }
     let busiest = r.cases.iter().filter_map(|c| c.load_avg).flatten().fold(0.0f64, f64::max);
     if busiest > r.cores as f64 + 0.5 {
         let _ = writeln!(

@@ -5,6 +5,8 @@ use serde::Serialize;
 use verlet::step::Part;
 use verlet::world::StageTimes;
 
+use crate::lavapipe::Dispatch;
+
 /// Per-stage cost of a step (ms per step, summed over substeps and iterations).
 #[derive(Clone, Debug, Serialize)]
 pub struct Stages {
@@ -129,6 +131,11 @@ pub struct CaseResult {
     /// (Linux): above the core count, other work shared the CPU (and so
     /// lavapipe) and the times are inflated.
     pub load_avg: Option<[f64; 2]>,
+    /// On lavapipe, where it ran each dispatch: on the submitting thread
+    /// for a case of at most `lavapipe::INLINE_MAX_BODIES` bodies, else on
+    /// its worker threads (`LP_NUM_THREADS` unset; `None` when the user
+    /// set it or the adapter is not lavapipe).
+    pub dispatch: Option<Dispatch>,
     pub peer: Option<PeerResult>,
 }
 

@@ -1,0 +1,83 @@
+//! On lavapipe, where a scene's dispatches run: lavapipe hands each one to
+//! its worker threads and waits for them, about 40 us a dispatch on two
+//! cores, most of a small scene's step; with `LP_NUM_THREADS=0` the thread
+//! that submits runs it (docs/lavapipe.md). `run` and `bench` pick this for
+//! small scenes, unless the user set `LP_NUM_THREADS`.
+
+use serde::Serialize;
+use verlet::gpu::Gpu;
+use verlet::Error;
+
+/// The most bodies a scene may have to run on the submitting thread: below
+/// about 600 (a pile four deep) to 1000 (cubes side by side) the hand-off
+/// costs more than the second core gives (docs/lavapipe.md).
+pub const INLINE_MAX_BODIES: u64 = 512;
+
+/// Where an adapter opened by `open` runs its dispatches (in the bench's
+/// JSON: `"workers"`, `"inline"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Dispatch {
+    /// Lavapipe's worker threads: `LP_NUM_THREADS` unset and a scene larger than `INLINE_MAX_BODIES`.
+    Workers,
+    /// The submitting thread: `LP_NUM_THREADS` unset and a scene of at most `INLINE_MAX_BODIES`.
+    Inline,
+    /// As the user's `LP_NUM_THREADS` says, or not lavapipe at all.
+    AsSet,
+}
+
+impl Dispatch {
+    /// The line `run` prints and the bench records, for lavapipe only.
+    pub fn describe(self) -> Option<String> {
+        match self {
+            Dispatch::Inline => Some(format!(
+                "each dispatch on the submitting thread (a scene of at most {INLINE_MAX_BODIES} bodies; LP_NUM_THREADS set by hand decides instead)"
+            )),
+            Dispatch::Workers => Some(format!(
+                "each dispatch on lavapipe's worker threads (a scene of more than {INLINE_MAX_BODIES} bodies; LP_NUM_THREADS set by hand decides instead)"
+            )),
+            Dispatch::AsSet => None,
+        }
+    }
+}
+
+/// Whether the user left lavapipe's thread count to us.
+fn unset() -> bool {
+    std::env::var_os("LP_NUM_THREADS").is_none()
+}
+
+/// Opens the adapter (`Gpu::new`) for a scene of `bodies` bodies: with
+/// `LP_NUM_THREADS=0` while it is made when the user left it unset and the
+/// scene is small, so that lavapipe runs each dispatch on the submitting
+/// thread (it reads the variable as an instance enumerates its adapters;
+/// other drivers ignore it). The environment is as the user gave it when
+/// this returns.
+///
+/// Call it before the process starts any thread: the environment is the
+/// whole process's, and another thread reading it while it changes is
+/// undefined behaviour in C (`std::env::set_var`).
+pub fn open(bodies: u64) -> Result<(Gpu, Dispatch), Error> {
+    if !unset() {
+        return Ok((Gpu::new()?, Dispatch::AsSet));
+    }
+    let inline = bodies <= INLINE_MAX_BODIES;
+    if inline {
+        std::env::set_var("LP_NUM_THREADS", "0");
+    }
+    let gpu = Gpu::new();
+    if inline {
+        std::env::remove_var("LP_NUM_THREADS");
+    }
+    let gpu = gpu?;
+    let dispatch = match (is_lavapipe(&gpu), inline) {
+        (false, _) => Dispatch::AsSet,
+        (true, true) => Dispatch::Inline,
+        (true, false) => Dispatch::Workers,
+    };
+    Ok((gpu, dispatch))
+}
+
+/// Whether `gpu` is lavapipe (Mesa's llvmpipe as a Vulkan driver).
+pub fn is_lavapipe(gpu: &Gpu) -> bool {
+    gpu.info.name.contains("llvmpipe")
+}

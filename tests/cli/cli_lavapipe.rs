@@ -1,0 +1,92 @@
+//! Where lavapipe runs a scene's dispatches: `verlet run` and `verlet
+//! bench` run a small scene's on the submitting thread (a hand-off to
+//! lavapipe's workers costs more than it gives there), a larger one's on
+//! the workers, and leave the choice to `LP_NUM_THREADS` when it is set.
+//! Where they run changes no bit.
+
+use crate::common::{no_adapter, temp_path};
+
+/// `verlet ARGS` with `LP_NUM_THREADS` as given (`None`: unset).
+fn verlet_with(threads: Option<&str>, args: &[&str]) -> std::process::Output {
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_verlet"));
+    command.args(args);
+    match threads {
+        Some(t) => command.env("LP_NUM_THREADS", t),
+        None => command.env_remove("LP_NUM_THREADS"),
+    };
+    command.output().expect("the verlet binary runs")
+}
+
+fn stdout(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stdout).to_string()
+}
+
+fn lavapipe_line(text: &str) -> Option<&str> {
+    text.lines().find(|l| l.starts_with("lavapipe:"))
+}
+
+#[test]
+fn a_small_scene_runs_on_the_submitting_thread_to_the_same_bits() {
+    let dir = temp_path("lavapipe-threads");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (inline, workers) = (dir.join("inline.json"), dir.join("workers.json"));
+    // ragdolls on a pile: contacts, joints along paths and sleeping
+    let run = |threads, path: &std::path::Path| {
+        let args = ["run", "--builtin", "ragdoll", "--count", "3", "--steps", "90", "--state-out", path.to_str().unwrap()];
+        verlet_with(threads, &args)
+    };
+    let out = run(None, &inline);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = stdout(&out);
+    if !text.contains("llvmpipe") {
+        assert!(lavapipe_line(&text).is_none(), "{text}");
+        return; // a real GPU: nothing to choose
+    }
+    let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
+    assert!(line.contains("each dispatch on the submitting thread"), "{line}");
+    let out = run(Some("2"), &workers);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(lavapipe_line(&stdout(&out)).is_none(), "LP_NUM_THREADS set, yet the run says it chose: {}", stdout(&out));
+    assert!(std::fs::read(&inline).unwrap() == std::fs::read(&workers).unwrap(), "the state differs by where lavapipe ran");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_larger_scene_runs_on_lavapipe_s_workers() {
+    let out = verlet_with(None, &["run", "--builtin", "cubes", "--count", "513", "--steps", "1"]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = stdout(&out);
+    if text.contains("llvmpipe") {
+        let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
+        assert!(line.contains("each dispatch on lavapipe's worker threads"), "{line}");
+    }
+}
+
+#[test]
+fn the_bench_says_where_each_case_ran() {
+    let dir = temp_path("lavapipe-bench");
+    std::fs::create_dir_all(&dir).unwrap();
+    let json = dir.join("report.json");
+    let args = ["bench", "--no-peer", "--cases", "cubes:10,cubes:600", "--steps", "2", "--reps", "1", "--profile-steps", "0"];
+    let out = verlet_with(None, &[&args[..], &["--json", json.to_str().unwrap()]].concat());
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let text = stdout(&out);
+    if !text.contains("llvmpipe") {
+        return;
+    }
+    let dispatch = |k: usize| report["cases"][k]["dispatch"].as_str().map(str::to_string);
+    assert_eq!((dispatch(0).as_deref(), dispatch(1).as_deref()), (Some("inline"), Some("workers")), "{report}");
+    let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
+    assert!(line.starts_with("lavapipe: cubes-10 ran each dispatch on the submitting thread"), "{line}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
