@@ -73,7 +73,19 @@ fn the_bench_says_where_each_case_ran() {
     let dir = temp_path("lavapipe-bench");
     std::fs::create_dir_all(&dir).unwrap();
     let json = dir.join("report.json");
-    let args = ["bench", "--no-peer", "--cases", "cubes:10,cubes:600", "--steps", "2", "--reps", "1", "--profile-steps", "0"];
+    let args = [
+        "bench",
+        "--no-peer",
+        "--cases",
+        "cubes:10,cubes:600",
+        "--steps",
+        "2",
+        "--reps",
+        "1",
+        "--profile-steps",
+        "0",
+        "--dispatch-cost",
+    ];
     let out = verlet_with(None, &[&args[..], &["--json", json.to_str().unwrap()]].concat());
     if no_adapter(&out) {
         return;
@@ -84,9 +96,14 @@ fn the_bench_says_where_each_case_ran() {
     if !text.contains("llvmpipe") {
         return;
     }
-    let dispatch = |k: usize| report["cases"][k]["dispatch"].as_str().map(str::to_string);
-    assert_eq!((dispatch(0).as_deref(), dispatch(1).as_deref()), (Some("inline"), Some("workers")), "{report}");
+    let ran = |k: usize| report["cases"][k]["lavapipe"].as_str().map(str::to_string);
+    assert_eq!((ran(0).as_deref(), ran(1).as_deref()), (Some("submitting_thread"), Some("worker_threads")), "{report}");
     let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
     assert!(line.starts_with("lavapipe: cubes-10 ran each dispatch on the submitting thread"), "{line}");
+    // what a dispatch costs, both ways (measured, not judged)
+    let cost = &report["dispatch"];
+    assert!(cost["us_per_dispatch"].as_f64().is_some_and(|us| us > 0.0), "{report}");
+    assert!(cost["inline"]["us_per_dispatch"].as_f64().is_some_and(|us| us > 0.0), "{report}");
+    assert!(text.contains("on lavapipe's submitting thread (LP_NUM_THREADS=0"), "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -14,13 +14,14 @@ use verlet::Error;
 pub const INLINE_MAX_BODIES: u64 = 512;
 
 /// Where an adapter opened by `open` runs its dispatches (in the bench's
-/// JSON: `"workers"`, `"inline"`).
+/// JSON, a case's `lavapipe`: `"worker_threads"`, `"submitting_thread"`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
 pub enum Dispatch {
     /// Lavapipe's worker threads: `LP_NUM_THREADS` unset and a scene larger than `INLINE_MAX_BODIES`.
+    #[serde(rename = "worker_threads")]
     Workers,
     /// The submitting thread: `LP_NUM_THREADS` unset and a scene of at most `INLINE_MAX_BODIES`.
+    #[serde(rename = "submitting_thread")]
     Inline,
     /// As the user's `LP_NUM_THREADS` says, or not lavapipe at all.
     AsSet,

@@ -26,7 +26,7 @@ pub fn blank(case: &Case, scene: &Scene, steps: u64, reps: usize) -> CaseResult 
         substeps: scene.settings.substeps,
         skipped: None,
         note: None,
-        dispatch: None,
+        lavapipe: None,
         steps,
         reps,
         startup_s: f64::NAN,

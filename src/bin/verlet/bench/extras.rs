@@ -12,10 +12,28 @@ use verlet::world::{self, World};
 use verlet::{scenes, Error};
 
 use super::median;
-use super::results::{DispatchCost, Settled};
+use super::results::{DispatchCost, InlineDispatchCost, Settled};
 
-/// Measures `DispatchCost`.
-pub fn dispatch_cost(gpu: &Arc<Gpu>) -> Result<DispatchCost, Error> {
+/// Measures `DispatchCost` on `gpu`, and on `inline` (lavapipe's
+/// submitting thread) where the bench opened it.
+pub fn dispatch_cost(gpu: &Arc<Gpu>, inline: Option<&Arc<Gpu>>) -> Result<DispatchCost, Error> {
+    let (dispatches, ms) = ten_cubes(gpu)?;
+    let us = |ms: f64| ms * 1e3 / dispatches as f64;
+    progress!("dispatches: {dispatches} a step; 10 cubes step in {ms:.2} ms: {:.0} us a dispatch", us(ms));
+    let inline = match inline {
+        Some(gpu) => {
+            let (_, ms) = ten_cubes(gpu)?;
+            progress!("dispatches on the submitting thread: 10 cubes step in {ms:.2} ms: {:.0} us a dispatch", us(ms));
+            Some(InlineDispatchCost { ten_cubes_ms_per_step: ms, us_per_dispatch: us(ms) })
+        }
+        None => None,
+    };
+    Ok(DispatchCost { dispatches_per_step: dispatches, ten_cubes_ms_per_step: ms, us_per_dispatch: us(ms), inline })
+}
+
+/// Ten cubes stepped 120 times after a first untimed step, sleeping off:
+/// the dispatches of a step and the wall clock a step (ms).
+fn ten_cubes(gpu: &Arc<Gpu>) -> Result<(usize, f64), Error> {
     let mut scene = scenes::cubes(10, SEED);
     // asleep, the world would come to rest and skip its steps
     scene.settings.sleeping = false;
@@ -26,12 +44,7 @@ pub fn dispatch_cost(gpu: &Arc<Gpu>) -> Result<DispatchCost, Error> {
     let t = Instant::now();
     world.step(steps)?;
     gpu.wait()?;
-    let ms = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
-    let dispatches = world.step_plan().len();
-    let out =
-        DispatchCost { dispatches_per_step: dispatches, ten_cubes_ms_per_step: ms, us_per_dispatch: ms * 1e3 / dispatches as f64 };
-    progress!("dispatches: {dispatches} a step; 10 cubes step in {ms:.2} ms: {:.0} us a dispatch", out.us_per_dispatch);
-    Ok(out)
+    Ok((world.step_plan().len(), t.elapsed().as_secs_f64() * 1e3 / steps as f64))
 }
 
 /// Renders the 1000-cube scene after 60 steps at 640 x 480: (set-up s, ms per frame).

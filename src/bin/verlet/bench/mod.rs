@@ -227,7 +227,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     let gpu = Arc::new(gpu);
     let gpu_open_s = started.elapsed().as_secs_f64();
     let small = |case: &Case| scenes::body_count(&case.scene, case.count).is_some_and(|n| n <= INLINE_MAX_BODIES);
-    let inline = match cases.iter().any(small) {
+    let inline = match cases.iter().any(small) || opts.extras.dispatch_cost {
         true => Some(lavapipe::open(0)?).filter(|(_, d)| *d == Dispatch::Inline).map(|(g, d)| (Arc::new(g), d)),
         false => None,
     };
@@ -246,7 +246,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
             _ => (&gpu, workers),
         };
         let mut r = run_case(case_gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
-        r.dispatch = (dispatch != Dispatch::AsSet).then_some(dispatch);
+        r.lavapipe = (dispatch != Dispatch::AsSet).then_some(dispatch);
         r.load_avg = before.zip(load_avg()).map(|(a, b)| [a, b]);
         results.push(r);
     }
@@ -254,7 +254,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     // taken after a render pass on the same device come out near zero, so a
     // render before a profile would corrupt the per-stage table.
     let extras = opts.extras;
-    let dispatch = if extras.dispatch_cost { Some(dispatch_cost(&gpu)?) } else { None };
+    let dispatch = if extras.dispatch_cost { Some(dispatch_cost(&gpu, inline.as_ref().map(|(g, _)| g))?) } else { None };
     let render = if extras.render { Some(render_cubes(&gpu)?) } else { None };
     let cold_start_s = if extras.cold_start { cold_start(if opts.quick { 1 } else { 3 }) } else { Vec::new() };
     // `--settle-steps N` alone asks for it too

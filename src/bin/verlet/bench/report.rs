@@ -105,7 +105,7 @@ pub fn table(r: &Report) -> String {
     let _ = writeln!(s, "peer:     {}", r.peer);
     let _ = writeln!(s, "solver:   {}", r.iterations);
     let _ = writeln!(s, "command:  {}", r.command);
-    let inline: Vec<&str> = r.cases.iter().filter(|c| c.dispatch == Some(Dispatch::Inline)).map(|c| c.case.as_str()).collect();
+    let inline: Vec<&str> = r.cases.iter().filter(|c| c.lavapipe == Some(Dispatch::Inline)).map(|c| c.case.as_str()).collect();
     if !inline.is_empty() {
         let _ = writeln!(
             s,
@@ -283,6 +283,14 @@ pub fn table(r: &Report) -> String {
             fmt_ms(d.ten_cubes_ms_per_step),
             d.us_per_dispatch
         );
+        if let Some(i) = &d.inline {
+            let _ = writeln!(
+                s,
+                "on lavapipe's submitting thread (LP_NUM_THREADS=0, as for scenes of at most {INLINE_MAX_BODIES} bodies): {} ms, about {:.0} us a dispatch",
+                fmt_ms(i.ten_cubes_ms_per_step),
+                i.us_per_dispatch
+            );
+        }
     }
     let asked: Vec<&str> = [
         (r.settled.is_none(), "--settle"),

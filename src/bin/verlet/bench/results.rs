@@ -135,7 +135,7 @@ pub struct CaseResult {
     /// for a case of at most `lavapipe::INLINE_MAX_BODIES` bodies, else on
     /// its worker threads (`LP_NUM_THREADS` unset; `None` when the user
     /// set it or the adapter is not lavapipe).
-    pub dispatch: Option<Dispatch>,
+    pub lavapipe: Option<Dispatch>,
     pub peer: Option<PeerResult>,
 }
 
@@ -195,6 +195,16 @@ pub struct Report {
 #[derive(Clone, Debug, Serialize)]
 pub struct DispatchCost {
     pub dispatches_per_step: usize,
+    pub ten_cubes_ms_per_step: f64,
+    pub us_per_dispatch: f64,
+    /// The same on lavapipe's submitting thread (`LP_NUM_THREADS=0`), where
+    /// the bench opened that adapter too (`LP_NUM_THREADS` unset).
+    pub inline: Option<InlineDispatchCost>,
+}
+
+/// `DispatchCost`'s step and dispatch on lavapipe's submitting thread.
+#[derive(Clone, Debug, Serialize)]
+pub struct InlineDispatchCost {
     pub ten_cubes_ms_per_step: f64,
     pub us_per_dispatch: f64,
 }
