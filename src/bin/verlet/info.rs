@@ -34,7 +34,7 @@ pub fn info() -> Result<(), Error> {
     let (most_pairs, most_manifolds) = verlet::world::pair_capacities(&gpu, u64::MAX);
     outln!("contact pools at most:      {most_pairs} pairs, {most_manifolds} manifolds")?;
     outln!("largest scene:              {} bodies", verlet::world::max_bodies(&gpu))?;
-    if i.name.contains("llvmpipe") {
+    if crate::lavapipe::is_lavapipe(&gpu) {
         // lavapipe hands every dispatch to its worker threads, and that
         // hand-off is most of a small scene's step (docs/lavapipe.md)
         let threads =

@@ -28,14 +28,14 @@ pub enum Dispatch {
 }
 
 impl Dispatch {
-    /// The line `run` prints and the bench records, for lavapipe only.
+    /// What `run` says of it after the time per step (lavapipe only).
     pub fn describe(self) -> Option<String> {
         match self {
             Dispatch::Inline => Some(format!(
-                "each dispatch on the submitting thread (a scene of at most {INLINE_MAX_BODIES} bodies; LP_NUM_THREADS set by hand decides instead)"
+                "each dispatch on the submitting thread, as for any scene of at most {INLINE_MAX_BODIES} bodies (LP_NUM_THREADS, when set, decides)"
             )),
             Dispatch::Workers => Some(format!(
-                "each dispatch on lavapipe's worker threads (a scene of more than {INLINE_MAX_BODIES} bodies; LP_NUM_THREADS set by hand decides instead)"
+                "each dispatch on lavapipe's worker threads, as for any scene of more than {INLINE_MAX_BODIES} bodies (LP_NUM_THREADS, when set, decides)"
             )),
             Dispatch::AsSet => None,
         }
@@ -76,6 +76,18 @@ pub fn open(bodies: u64) -> Result<(Gpu, Dispatch), Error> {
         (true, false) => Dispatch::Workers,
     };
     Ok((gpu, dispatch))
+}
+
+/// The adapter on lavapipe's submitting thread, for the bench's small
+/// cases beside `open`'s for the others; `None` where the user set
+/// `LP_NUM_THREADS` or the adapter is not lavapipe. Before any thread
+/// starts, as `open`.
+pub fn open_inline() -> Result<Option<Gpu>, Error> {
+    if !unset() {
+        return Ok(None);
+    }
+    let (gpu, dispatch) = open(0)?;
+    Ok((dispatch == Dispatch::Inline).then_some(gpu))
 }
 
 /// Whether `gpu` is lavapipe (Mesa's llvmpipe as a Vulkan driver).

@@ -221,14 +221,15 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     paths::check_distinct(&[], &outputs)?;
 
     let started = Instant::now();
-    // both adapters before any thread starts (the peer's pools): `lavapipe::open`
-    // may set the environment while it opens one
+    // Both adapters before any thread starts (the peer's pools): opening one
+    // may set the environment. On lavapipe the larger cases and the extras
+    // run on its workers, the small cases on the submitting thread.
     let (gpu, workers) = lavapipe::open(u64::MAX)?;
     let gpu = Arc::new(gpu);
     let gpu_open_s = started.elapsed().as_secs_f64();
     let small = |case: &Case| scenes::body_count(&case.scene, case.count).is_some_and(|n| n <= INLINE_MAX_BODIES);
     let inline = match cases.iter().any(small) || opts.extras.dispatch_cost {
-        true => Some(lavapipe::open(0)?).filter(|(_, d)| *d == Dispatch::Inline).map(|(g, d)| (Arc::new(g), d)),
+        true => lavapipe::open_inline()?.map(Arc::new),
         false => None,
     };
     let max = world::max_bodies(&gpu);
@@ -242,7 +243,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     for case in &cases {
         let before = load_avg();
         let (case_gpu, dispatch) = match &inline {
-            Some((g, d)) if small(case) => (g, *d),
+            Some(g) if small(case) => (g, Dispatch::Inline),
             _ => (&gpu, workers),
         };
         let mut r = run_case(case_gpu, case, (steps, body_steps), reps, profile_steps, max, opts)?;
@@ -254,7 +255,7 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     // taken after a render pass on the same device come out near zero, so a
     // render before a profile would corrupt the per-stage table.
     let extras = opts.extras;
-    let dispatch = if extras.dispatch_cost { Some(dispatch_cost(&gpu, inline.as_ref().map(|(g, _)| g))?) } else { None };
+    let dispatch = if extras.dispatch_cost { Some(dispatch_cost(&gpu, inline.as_ref())?) } else { None };
     let render = if extras.render { Some(render_cubes(&gpu)?) } else { None };
     let cold_start_s = if extras.cold_start { cold_start(if opts.quick { 1 } else { 3 }) } else { Vec::new() };
     // `--settle-steps N` alone asks for it too
