@@ -1,8 +1,8 @@
 //! Where lavapipe runs a scene's dispatches: `verlet run` and `verlet
 //! bench` run a small scene's on the submitting thread (a hand-off to
-//! lavapipe's workers costs more than it gives there), a larger one's on
-//! the workers, and leave the choice to `LP_NUM_THREADS` when it is set.
-//! Where they run changes no bit.
+//! lavapipe's workers costs more than it gives there), a larger one's, or
+//! one whose frames are drawn, on the workers, and leave the choice to
+//! `LP_NUM_THREADS` when it is set. Where they run changes no bit.
 
 use crate::common::{no_adapter, temp_path};
 
@@ -66,6 +66,24 @@ fn a_larger_scene_runs_on_lavapipe_s_workers() {
         let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
         assert!(line.contains("each dispatch on lavapipe's worker threads"), "{line}");
     }
+}
+
+/// Lavapipe draws frames on the same threads, and a frame is far more work
+/// than a dispatch's hand-off: a run that draws keeps the workers.
+#[test]
+fn a_small_scene_that_draws_frames_runs_on_lavapipe_s_workers() {
+    let dir = temp_path("lavapipe-frames");
+    let out = verlet_with(None, &["run", "--builtin", "chain", "--steps", "2", "--frames", dir.to_str().unwrap()]);
+    if no_adapter(&out) {
+        return;
+    }
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = stdout(&out);
+    if text.contains("llvmpipe") {
+        let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
+        assert!(line.contains("each dispatch on lavapipe's worker threads"), "{line}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

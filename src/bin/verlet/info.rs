@@ -42,7 +42,7 @@ pub fn info() -> Result<(), Error> {
         outln!(
             "software adapter:           lavapipe's worker threads take each dispatch ({threads}); \
              LP_NUM_THREADS=0 runs them on the submitting thread, faster for scenes of up to a few hundred bodies \
-             (unset, `verlet run` and `verlet bench` choose it for scenes of at most {} bodies)",
+             (unset, `verlet run` and `verlet bench` choose it for scenes of at most {} bodies that draw no frames)",
             crate::lavapipe::INLINE_MAX_BODIES
         )?;
     }

@@ -2,7 +2,7 @@
 //! its worker threads and waits for them, about 40 us a dispatch on two
 //! cores, most of a small scene's step; with `LP_NUM_THREADS=0` the thread
 //! that submits runs it (docs/lavapipe.md). `run` and `bench` pick this for
-//! small scenes, unless the user set `LP_NUM_THREADS`.
+//! small scenes that render nothing, unless the user set `LP_NUM_THREADS`.
 
 use serde::Serialize;
 use verlet::gpu::Gpu;
@@ -12,6 +12,13 @@ use verlet::Error;
 /// about 600 (a pile four deep) to 1000 (cubes side by side) the hand-off
 /// costs more than the second core gives (docs/lavapipe.md).
 pub const INLINE_MAX_BODIES: u64 = 512;
+
+/// Whether a run of `bodies` bodies suits the submitting thread: a small
+/// scene, and no frames drawn (lavapipe rasterises on the same threads, and
+/// a frame is far more work than a dispatch's hand-off).
+pub fn suits_inline(bodies: u64, renders: bool) -> bool {
+    bodies <= INLINE_MAX_BODIES && !renders
+}
 
 /// Where an adapter opened by `open` runs its dispatches (in the bench's
 /// JSON, a case's `lavapipe`: `"worker_threads"`, `"submitting_thread"`).
@@ -35,7 +42,7 @@ impl Dispatch {
                 "each dispatch on the submitting thread, as for any scene of at most {INLINE_MAX_BODIES} bodies (LP_NUM_THREADS, when set, decides)"
             )),
             Dispatch::Workers => Some(format!(
-                "each dispatch on lavapipe's worker threads, as for any scene of more than {INLINE_MAX_BODIES} bodies (LP_NUM_THREADS, when set, decides)"
+                "each dispatch on lavapipe's worker threads, as for any scene of more than {INLINE_MAX_BODIES} bodies or any run that draws frames (LP_NUM_THREADS, when set, decides)"
             )),
             Dispatch::AsSet => None,
         }
@@ -47,21 +54,19 @@ fn unset() -> bool {
     std::env::var_os("LP_NUM_THREADS").is_none()
 }
 
-/// Opens the adapter (`Gpu::new`) for a scene of `bodies` bodies: with
-/// `LP_NUM_THREADS=0` while it is made when the user left it unset and the
-/// scene is small, so that lavapipe runs each dispatch on the submitting
-/// thread (it reads the variable as an instance enumerates its adapters;
-/// other drivers ignore it). The environment is as the user gave it when
-/// this returns.
+/// Opens the adapter (`Gpu::new`), with `LP_NUM_THREADS=0` while it is made
+/// when `inline` (`suits_inline`) and the user left the variable unset, so
+/// that lavapipe runs each dispatch on the submitting thread (it reads the
+/// variable as an instance enumerates its adapters; other drivers ignore
+/// it). The environment is as the user gave it when this returns.
 ///
 /// Call it before the process starts any thread: the environment is the
 /// whole process's, and another thread reading it while it changes is
 /// undefined behaviour in C (`std::env::set_var`).
-pub fn open(bodies: u64) -> Result<(Gpu, Dispatch), Error> {
+pub fn open(inline: bool) -> Result<(Gpu, Dispatch), Error> {
     if !unset() {
         return Ok((Gpu::new()?, Dispatch::AsSet));
     }
-    let inline = bodies <= INLINE_MAX_BODIES;
     if inline {
         std::env::set_var("LP_NUM_THREADS", "0");
     }
@@ -86,7 +91,7 @@ pub fn open_inline() -> Result<Option<Gpu>, Error> {
     if !unset() {
         return Ok(None);
     }
-    let (gpu, dispatch) = open(0)?;
+    let (gpu, dispatch) = open(true)?;
     Ok((dispatch == Dispatch::Inline).then_some(gpu))
 }
 

@@ -143,6 +143,11 @@ pub struct Recorder {
     last_step: Option<u64>,
 }
 
+/// Whether the run draws frames: `--frames`, `--gif` or `--contact-sheet`.
+pub fn wants_images(args: &RunArgs) -> bool {
+    args.frames.is_some() || args.gif.is_some() || args.contact_sheet.is_some()
+}
+
 impl Recorder {
     /// Makes the renderer if any image is wanted (refusing a size beyond
     /// the adapter's), then creates the frames directory, then opens the
@@ -152,8 +157,7 @@ impl Recorder {
     /// its first step makes nothing. Nothing the user had is touched until
     /// the run succeeds.
     pub fn open(args: &RunArgs, gpu: &Gpu, scene: &Scene) -> Result<Recorder, Error> {
-        let wants_images = args.frames.is_some() || args.gif.is_some() || args.contact_sheet.is_some();
-        let renderer = if wants_images {
+        let renderer = if wants_images(args) {
             Some(
                 Renderer::new(gpu, scene, args.width, args.height)
                     .map_err(|e| e.for_flag("width", "--width").for_flag("height", "--height"))?,

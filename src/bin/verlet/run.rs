@@ -36,7 +36,7 @@ pub fn run(mut args: RunArgs) -> Result<(), Error> {
 
     // before any thread starts (the progress bar's): `lavapipe::open` may set
     // the environment while it opens the adapter
-    let (gpu, dispatch) = lavapipe::open(body_count)?;
+    let (gpu, dispatch) = lavapipe::open(lavapipe::suits_inline(body_count, record::wants_images(&args)))?;
     let gpu = Arc::new(gpu);
     let started = Instant::now();
     let scene = match file_scene {

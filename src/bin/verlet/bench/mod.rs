@@ -56,7 +56,7 @@ use verlet::bench::{Case, CASES, QUICK_CASES};
 use verlet::{scenes, world, Error};
 
 use crate::cli::BenchArgs;
-use crate::lavapipe::{self, Dispatch, INLINE_MAX_BODIES};
+use crate::lavapipe::{self, Dispatch};
 use crate::paths;
 use case::run_case;
 use extras::{cold_start, dispatch_cost, render_cubes, settle};
@@ -224,10 +224,10 @@ pub fn run(opts: &Options) -> Result<Report, Error> {
     // Both adapters before any thread starts (the peer's pools): opening one
     // may set the environment. On lavapipe the larger cases and the extras
     // run on its workers, the small cases on the submitting thread.
-    let (gpu, workers) = lavapipe::open(u64::MAX)?;
+    let (gpu, workers) = lavapipe::open(false)?;
     let gpu = Arc::new(gpu);
     let gpu_open_s = started.elapsed().as_secs_f64();
-    let small = |case: &Case| scenes::body_count(&case.scene, case.count).is_some_and(|n| n <= INLINE_MAX_BODIES);
+    let small = |case: &Case| scenes::body_count(&case.scene, case.count).is_some_and(|n| lavapipe::suits_inline(n, false));
     let inline = match cases.iter().any(small) || opts.extras.dispatch_cost {
         true => lavapipe::open_inline()?.map(Arc::new),
         false => None,
