@@ -196,6 +196,24 @@ fn dispatch_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
     return gid.x + gid.y * groups.x * WORKGROUP;
 }
 
+// Whether this step keeps the last pair list, empty, and skips the grid and
+// the pair walks: the last walks found no pair within keep_margin() more than
+// they list (contact_lists carries that into status[STATUS_WALK]), and no
+// body's grown box has left what they saw by half that (grid_count), so walks
+// now would find none either. A hanging grid at rest keeps it for good; a
+// body that moves walks again. The word stays put from grid_count to
+// contact_lists.
+fn pairs_kept() -> bool {
+    return atomicLoad(&status[STATUS_WALK]) == 0u;
+}
+
+// The margin (m) beyond CONTACT_MARGIN within which the walks note a pair as
+// near: within 0.001 of a cell, which a walk's neighbouring cells still cover
+// (`fast_size` in grid.wgsl leaves that slack).
+fn keep_margin() -> f32 {
+    return 0.0009 * params.cell_size;
+}
+
 // The manifolds this step's narrowphase stored (status[STATUS_MANIFOLDS], within the pool).
 fn manifolds_used() -> u32 {
     return min(atomicLoad(&status[STATUS_MANIFOLDS]), arrayLength(&manifolds));

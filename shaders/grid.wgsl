@@ -86,12 +86,14 @@ fn is_fast(size: f32, moves: u32) -> bool {
 }
 
 // Counts body i into its bucket and writes what the pair walks read of it
-// (PairMeta's moves, extent, bound, reach). Invocation 0 also empties the
-// pool's counters and the step's flags (the step's first pass).
+// (PairMeta's moves, extent, bound, reach). Where the last walks found
+// nothing near (`pairs_kept`), it takes the bodies in their grid order, so
+// that each meets the bounds they saw of it (cell_bounds at the same place)
+// and says whether it left them. Invocation 0 also empties the pool's
+// counters and the step's flags (the step's first pass).
 @compute @workgroup_size(WORKGROUP)
 fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i == 0u) {
+    if (gid.x == 0u) {
         atomicStore(&status[STATUS_MANIFOLDS], 0u);
         atomicStore(&status[STATUS_MANIFOLDS_TOP], 0u);
         atomicStore(&status[STATUS_MANIFOLDS_BOTTOM], 0u);
@@ -101,10 +103,16 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&status[STATUS_LISTED_DISPATCH], 0u);
         atomicStore(&status[STATUS_TOUCHING], 0u);
         atomicStore(&status[STATUS_TOUCHING_DISPATCH], 0u);
+        // the bodies kept out of the grid have no place in it to compare with
+        atomicMax(&status[STATUS_WALK], u32(params.large_count != 0u));
     }
-    if (i >= params.body_count) {
+    if (gid.x >= params.body_count) {
         return;
     }
+    // (the same results in either order; index order reads memory in turn.
+    // `near` stays put all step, where `walk` changes in this very pass)
+    let keepable = atomicLoad(&status[STATUS_NEAR]) == 0u;
+    let i = select(gid.x, sorted[gid.x], keepable);
     let s = state_of(i);
     let p = props_of(i);
     let reach = reach_of(s);
@@ -112,15 +120,31 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     let fixed = is_fixed(p);
     let moves = !fixed && (!asleep(s) || (s.pos_low & WAKES) != 0u);
     let sleeps = !fixed && !moves;
-    pair_meta[i].moves = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
+    let moves_code = select(select(STAYS_FIXED, SLEEPS, sleeps), MOVES, moves);
+    let moves_before = pair_meta[i].moves;
+    pair_meta[i].moves = moves_code;
     atomicStore(&pair_meta[i].cursor, 0u); // pairs_count counts incoming pairs here
     pair_meta[i].reach = reach + spin;
     pair_meta[i].spin = spin;
-    pair_meta[i].extent = body_extent(s, p) + vec3<f32>(reach + spin);
+    let extent = body_extent(s, p) + vec3<f32>(reach + spin);
+    pair_meta[i].extent = extent;
     // the bounding sphere turns into itself: only the centre's move grows it
-    pair_meta[i].bound = bound_sphere(p).w + reach;
+    let bound = bound_sphere(p).w + reach;
+    pair_meta[i].bound = bound;
     if (!grid_body(p)) {
         return;
+    }
+    if (keepable) {
+        // still within half keep_margin() of the bounds the last walks saw?
+        let seen = cell_bound_of(gid.x);
+        let drift = s.pos - seen.pos;
+        let half = 0.5 * keep_margin();
+        let within = all(abs(drift) + max(extent - seen.extent, vec3<f32>(0.0)) <= vec3<f32>(half))
+            && length(drift) + max(bound - seen.bound, 0.0) <= half;
+        let same = (seen.body & BODY_BITS) == i && moves_code == moves_before;
+        if (!(within && same) && atomicLoad(&status[STATUS_WALK]) == 0u) {
+            atomicStore(&status[STATUS_WALK], 1u);
+        }
     }
     // the movers' walks look for sleepers behind them too; one store sets it
     if (sleeps && atomicLoad(&status[STATUS_GRID_SLEEPS]) == 0u) {
@@ -182,8 +206,21 @@ fn scan_written(k: u32) -> vec2<u32> {
 // A block is SCAN_SPAN = SCAN_BLOCK x SCAN_RUN elements: each invocation sums
 // a run of SCAN_RUN in turn, then the workgroup scans the runs' totals (its
 // barriers, not the sums, are what such a pass costs on lavapipe).
+// pairs_kept(), read once by a workgroup that meets barriers
+var<workgroup> scan_kept: u32;
+
+fn scan_skipped(lid: u32) -> bool {
+    if (lid == 0u) {
+        scan_kept = u32(pairs_kept());
+    }
+    return workgroupUniformLoad(&scan_kept) != 0u;
+}
+
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_id) wid: vec3<u32>) {
+    if (scan_skipped(lid.x)) {
+        return;
+    }
     let first = wid.x * SCAN_SPAN + lid.x * SCAN_RUN;
     let end = min(first + SCAN_RUN, scan_len());
     var total = vec2<u32>(0u);
@@ -228,7 +265,7 @@ fn finish_scan(sum: vec2<u32>) {
 // invocation scanning a run of blocks first (none for a scan of one block).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
-    if (scan_len() <= SCAN_SPAN) {
+    if (scan_len() <= SCAN_SPAN || scan_skipped(lid.x)) {
         return;
     }
     let blocks = (scan_len() + SCAN_SPAN - 1u) / SCAN_SPAN;
@@ -259,7 +296,7 @@ fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
 @compute @workgroup_size(WORKGROUP)
 fn scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
-    if (h < scan_len()) {
+    if (h < scan_len() && !pairs_kept()) {
         cell_start[h] = cell_start[h] + block_sums[h / SCAN_SPAN].x;
     }
 }
@@ -271,6 +308,11 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let h = bucket_of(cell_of(state_of(i).pos));
+    if (pairs_kept()) {
+        // the grid stays as the last walks saw it; the counts start again at 0
+        atomicStore(&cell_count[h], 0u);
+        return;
+    }
     // from the bucket's start as the count goes down, in arrival order
     sorted[params.body_count + cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
 }
@@ -295,7 +337,7 @@ fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
         let bound = CellBound(large_centre(j), pair_meta[j].bound, pair_meta[j].extent, j | (pair_meta[j].moves << MOVES_SHIFT));
         set_cell_bound(params.body_count - params.large_count + i, bound);
     }
-    if (i >= params.body_count || !in_grid(i)) {
+    if (i >= params.body_count || !in_grid(i) || pairs_kept()) {
         return;
     }
     let pos = state_of(i).pos;

@@ -303,6 +303,14 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         write_dispatch(STATUS_MANIFOLDS_DISPATCH, manifolds_used());
         // the pair walks are done: grid_count sets it again next step
         atomicStore(&status[STATUS_GRID_SLEEPS], 0u);
+        // what the walks found near, where they walked, stands until they walk
+        // again; the next step walks if it found some (`pairs_kept`), or if
+        // grid_count finds a body that moved
+        if (!pairs_kept()) {
+            atomicStore(&status[STATUS_NEAR], atomicLoad(&status[STATUS_NEAR_NOW]));
+            atomicStore(&status[STATUS_NEAR_NOW], 0u);
+        }
+        atomicStore(&status[STATUS_WALK], atomicLoad(&status[STATUS_NEAR]));
     }
     if (i >= params.body_count) {
         return;

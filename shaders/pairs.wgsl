@@ -39,6 +39,27 @@ fn wanted_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u
     return (walker.moves || moves_j == MOVES) && dot(d, d) <= spheres * spheres && all(apart <= vec3<f32>(CONTACT_MARGIN));
 }
 
+// Whether the walker and body j come within keep_margin() more than
+// wanted_bounds asks (`pairs_kept`): a superset of its pairs.
+fn near_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u32) -> bool {
+    let margin = CONTACT_MARGIN + keep_margin();
+    let d = walker.pos - pos_j;
+    let spheres = walker.bound + bound_j + margin;
+    let apart = abs(d) - walker.extent - extent_j;
+    return (walker.moves || moves_j == MOVES) && dot(d, d) <= spheres * spheres && all(apart <= vec3<f32>(margin));
+}
+
+// Whether this walk looks for pairs near (`pairs_kept`): only where the last
+// walks listed none; after any, the list is not kept (pairs_count says so).
+var<private> testing_near: bool;
+
+// Notes that this step's walks found a pair near.
+fn note_near() {
+    if (testing_near && atomicLoad(&status[STATUS_NEAR_NOW]) == 0u) {
+        atomicStore(&status[STATUS_NEAR_NOW], 1u);
+    }
+}
+
 // Whether body i, its bounds centred at `centre`, is near enough the ground for a ground pair.
 fn wants_ground(i: u32, centre: vec3<f32>) -> bool {
     return params.has_ground != 0u && pair_meta[i].moves == MOVES
@@ -121,7 +142,9 @@ fn take(j: u32) {
 // sorted along x (grid_sort), so the walk stops at the first box beyond reach
 // (with slack for rounding); a walk of the whole grid order has no stop.
 fn visit_places(first: u32, end: u32, c: vec3<i32>, any_cell: bool, above: u32, behind: bool) {
-    let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + 1e-4 + 1e-5 * abs(walker.pos.x);
+    // (the near pairs' reach too where they are looked for: the pairs taken are the same)
+    let stop = walker.pos.x + walker.extent.x + CONTACT_MARGIN + select(0.0, keep_margin(), testing_near) + 1e-4
+        + 1e-5 * abs(walker.pos.x);
     for (var k = first; k < end; k = k + 1u) {
         trips = trips + 1u;
         let cb = cell_bound_of(k);
@@ -141,8 +164,13 @@ fn visit_places(first: u32, end: u32, c: vec3<i32>, any_cell: bool, above: u32, 
         }
         // (whether the two are joined is the narrowphase's to say: a loop over
         // joint ends here cost loop trips at every place)
-        if (takes && (any_cell || all(cell_of(cb.pos) == c)) && wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j)) {
-            take(j);
+        if (takes && (any_cell || all(cell_of(cb.pos) == c))) {
+            if (wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j)) {
+                take(j);
+            }
+            if (testing_near && near_bounds(cb.pos, cb.bound, cb.extent, moves_j)) {
+                note_near();
+            }
         }
     }
 }
@@ -193,6 +221,11 @@ fn walk(i: u32) {
                     grid && is_fast(size, pair_meta[i].moves));
     owned = 0u;
     trips = 0u;
+    // a fast walker, or a body near the ground, keeps the list from being kept
+    let ground_gap = walker.pos.y - walker.extent.y - params.ground_height;
+    if (testing_near && (walker.fast || (params.has_ground != 0u && walker.moves && ground_gap <= CONTACT_MARGIN + keep_margin()))) {
+        note_near();
+    }
     if (wants_ground(i, walker.pos)) {
         if (writing) {
             write_owned(GROUND);
@@ -250,6 +283,15 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the grid's arrivals are done with: the body lists start empty (`listed_body`, `touching_body`)
         sorted[LISTED_RUN * params.body_count + gid.x] = NONE;
         sorted[TOUCHING_RUN * params.body_count + gid.x] = NONE;
+        if (pairs_kept()) {
+            return; // the last walks' list, empty, stands
+        }
+        // (the pairs the last walks counted: the scan has not yet written this step's)
+        let listed_none = atomicLoad(&status[STATUS_PAIRS]) == 0u;
+        if (gid.x == 0u && !listed_none) {
+            atomicStore(&status[STATUS_NEAR_NOW], 1u);
+        }
+        testing_near = listed_none;
         writing = false;
         room_start = gid.x * scratch_room();
         walk(i);
@@ -274,7 +316,7 @@ fn note_long_walks() {
 
 @compute @workgroup_size(WORKGROUP)
 fn pairs_write(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.body_count) {
+    if (gid.x >= params.body_count || pairs_kept()) {
         return;
     }
     let i = sorted[gid.x];

@@ -10,7 +10,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::limits::NO_FAULT;
 
-/// The status words, in buffer order (104 bytes). The host reads it back
+/// The status words, in buffer order (116 bytes). The host reads it back
 /// after each batch of steps (`World::fit_pools`), and on request.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -52,6 +52,17 @@ pub struct Status {
     pub touching: u32,
     /// Their indirect dispatch, counted and copied as `listed_dispatch` is.
     pub touching_dispatch: [u32; 3],
+    /// 1 if the last pair walks found a pair within `keep_margin` more than
+    /// the contact margin, a fast body or a body near the ground (bindings.wgsl's
+    /// `pairs_kept`): contact_lists sets it from `near_now` after a step that walked.
+    pub near: u32,
+    /// What this step's walks found of that (pairs_count sets it).
+    pub near_now: u32,
+    /// 1 if this step builds the grid and walks for pairs: `near` as the
+    /// last step left it (contact_lists), or set by grid_count where a body's
+    /// grown box left the bounds the last walks saw by half `keep_margin`, or
+    /// its `moves` changed. 0: the step keeps the last pair list, empty.
+    pub walk: u32,
     /// 1 once a pair walk took so many loop trips that the driver may have cut it short (LOOP_TRIPS); never cleared.
     pub walks_cut: u32,
     /// 1 once a contact list's sort may have been cut short alike (contact_lists); never cleared.
@@ -89,6 +100,10 @@ impl Status {
         listed_dispatch: [0, 1, 1],
         touching: 0,
         touching_dispatch: [0, 1, 1],
+        // no walk yet: the first step walks
+        near: 1,
+        near_now: 0,
+        walk: 1,
         walks_cut: 0,
         lists_cut: 0,
     };
@@ -96,7 +111,7 @@ impl Status {
     /// The WGSL name and the first word of every field, in order: the
     /// shared constants (`shaders::shared_constants`) by which WGSL indexes
     /// the status words.
-    pub const WORDS: [(&'static str, u32); 18] = [
+    pub const WORDS: [(&'static str, u32); 21] = [
         ("STATUS_PAIRS", word!(pairs)),
         ("STATUS_PAIRS_MAX", word!(pairs_max)),
         ("STATUS_FAULT", word!(fault)),
@@ -113,6 +128,9 @@ impl Status {
         ("STATUS_LISTED_DISPATCH", word!(listed_dispatch)),
         ("STATUS_TOUCHING", word!(touching)),
         ("STATUS_TOUCHING_DISPATCH", word!(touching_dispatch)),
+        ("STATUS_NEAR", word!(near)),
+        ("STATUS_NEAR_NOW", word!(near_now)),
+        ("STATUS_WALK", word!(walk)),
         ("STATUS_WALKS_CUT", word!(walks_cut)),
         ("STATUS_LISTS_CUT", word!(lists_cut)),
     ];

@@ -177,7 +177,7 @@ pub(crate) const TABLE: [StageInfo; 25] = {
     const JOINT_READS: &[Buffer] = &[Params, Props, StateOut, JointStart, JointRefs];
     let table = [
         S {
-            reads: &[Params, Props, StateIn, CellCount, Status, Hulls],
+            reads: &[Params, Props, StateIn, CellCount, Status, Sorted, PairMeta, CellBounds, Hulls],
             writes: &[CellCount, Status, PairMeta],
             ..S::row(Stage::GridCount, "grid_count", GRID_PASS, Broadphase)
         },
@@ -200,17 +200,17 @@ pub(crate) const TABLE: [StageInfo; 25] = {
             entry_point: "scan_add",
             over: Over::Buckets,
             runs: Runs::EachStepOverManyBuckets,
-            reads: &[Params, CellStart, BlockSums],
+            reads: &[Params, CellStart, BlockSums, Status],
             writes: &[CellStart],
             ..S::row(Stage::GridScanAdd, "grid_scan_add", GRID_PASS, Broadphase)
         },
         S {
-            reads: &[Params, Props, StateIn, CellCount, CellStart],
+            reads: &[Params, Props, StateIn, CellCount, CellStart, Status],
             writes: &[CellCount, Sorted],
             ..S::row(Stage::GridScatter, "grid_scatter", GRID_PASS, Broadphase)
         },
         S {
-            reads: &[Params, Props, StateIn, CellStart, Sorted, PairMeta, Hulls],
+            reads: &[Params, Props, StateIn, CellStart, Sorted, PairMeta, Status, Hulls],
             writes: &[Sorted, CellBounds],
             ..S::row(Stage::GridSort, "grid_sort", GRID_PASS, Broadphase)
         },
@@ -238,7 +238,7 @@ pub(crate) const TABLE: [StageInfo; 25] = {
         },
         S {
             reads: &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds, Hulls],
-            writes: &[Pairs, PairMeta, BodyPairs],
+            writes: &[Pairs, Status, PairMeta, BodyPairs],
             ..S::row(Stage::PairsWrite, "pairs_write", PAIRS_PASS, Narrowphase)
         },
         S {

@@ -315,6 +315,9 @@ impl World {
         }
         encoder.copy_buffer_to_buffer(status, 0, &self.data.status, 0, Status::BYTES);
         self.gpu.submit(encoder.finish());
+        // the grid and the bounds the walks saw are the batch's later ones: walk again
+        let walk = std::mem::offset_of!(Status, walk) as u64;
+        self.gpu.queue.write_buffer(&self.data.status, walk, bytemuck::bytes_of(&1u32));
     }
 
     /// Counts `steps` steps of `dt` of a world at rest (`at_rest`): what

@@ -244,6 +244,9 @@ fn status_words_match_the_struct() {
         listed_dispatch => "STATUS_LISTED_DISPATCH",
         touching => "STATUS_TOUCHING",
         touching_dispatch => "STATUS_TOUCHING_DISPATCH",
+        near => "STATUS_NEAR",
+        near_now => "STATUS_NEAR_NOW",
+        walk => "STATUS_WALK",
         walks_cut => "STATUS_WALKS_CUT",
         lists_cut => "STATUS_LISTS_CUT",
     );

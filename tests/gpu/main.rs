@@ -15,6 +15,7 @@ mod device_faults;
 mod faults;
 mod hull_reference;
 mod input_track;
+mod kept_pairs;
 mod kernels;
 mod layouts;
 mod narrowphase_parity;
