@@ -54,9 +54,10 @@ fn a_small_scene_runs_on_the_submitting_thread_to_the_same_bits() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn a_larger_scene_runs_on_lavapipe_s_workers() {
-    let out = verlet_with(None, &["run", "--builtin", "cubes", "--count", "513", "--steps", "1"]);
+/// `verlet ARGS` with `LP_NUM_THREADS` unset succeeds and, on lavapipe,
+/// its `lavapipe:` line says `ran`.
+fn assert_ran(args: &[&str], ran: &str) {
+    let out = verlet_with(None, args);
     if no_adapter(&out) {
         return;
     }
@@ -64,8 +65,13 @@ fn a_larger_scene_runs_on_lavapipe_s_workers() {
     let text = stdout(&out);
     if text.contains("llvmpipe") {
         let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
-        assert!(line.contains("each dispatch on lavapipe's worker threads"), "{line}");
+        assert!(line.contains(ran), "{line}");
     }
+}
+
+#[test]
+fn a_larger_scene_runs_on_lavapipe_s_workers() {
+    assert_ran(&["run", "--builtin", "cubes", "--count", "513", "--steps", "1"], "each dispatch on lavapipe's worker threads");
 }
 
 /// Lavapipe draws frames on the same threads, and a frame is far more work
@@ -73,16 +79,8 @@ fn a_larger_scene_runs_on_lavapipe_s_workers() {
 #[test]
 fn a_small_scene_that_draws_frames_runs_on_lavapipe_s_workers() {
     let dir = temp_path("lavapipe-frames");
-    let out = verlet_with(None, &["run", "--builtin", "chain", "--steps", "2", "--frames", dir.to_str().unwrap()]);
-    if no_adapter(&out) {
-        return;
-    }
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = stdout(&out);
-    if text.contains("llvmpipe") {
-        let line = lavapipe_line(&text).unwrap_or_else(|| panic!("no lavapipe line: {text}"));
-        assert!(line.contains("each dispatch on lavapipe's worker threads"), "{line}");
-    }
+    let args = ["run", "--builtin", "chain", "--steps", "2", "--frames", dir.to_str().unwrap()];
+    assert_ran(&args, "each dispatch on lavapipe's worker threads");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
