@@ -203,12 +203,11 @@ fn scan_written(k: u32) -> vec2<u32> {
     return vec2<u32>(cell_start[k], 0u);
 }
 
-// A block is SCAN_SPAN = SCAN_BLOCK x SCAN_RUN elements: each invocation sums
-// a run of SCAN_RUN in turn, then the workgroup scans the runs' totals (its
-// barriers, not the sums, are what such a pass costs on lavapipe).
 // pairs_kept(), read once by a workgroup that meets barriers
 var<workgroup> scan_kept: u32;
 
+// Whether the scan is not needed this step (`pairs_kept`), the same for the
+// whole workgroup; every invocation must call it.
 fn scan_skipped(lid: u32) -> bool {
     if (lid == 0u) {
         scan_kept = u32(pairs_kept());
@@ -216,6 +215,9 @@ fn scan_skipped(lid: u32) -> bool {
     return workgroupUniformLoad(&scan_kept) != 0u;
 }
 
+// A block is SCAN_SPAN = SCAN_BLOCK x SCAN_RUN elements: each invocation sums
+// a run of SCAN_RUN in turn, then the workgroup scans the runs' totals (its
+// barriers, not the sums, are what such a pass costs on lavapipe).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_id) wid: vec3<u32>) {
     if (scan_skipped(lid.x)) {
