@@ -28,42 +28,43 @@ fn pair_margin(lo: u32, hi: u32) -> f32 {
     return CONTACT_MARGIN + min(relative, pair_meta[lo].reach + pair_meta[hi].reach);
 }
 
-// Whether the walker and body j form a candidate pair: one of them moves and
-// their bounding spheres and grown world boxes come within CONTACT_MARGIN (the
-// spheres cut the boxes' corners). Every sum takes one term of each body, so
-// either walk gets the same bits; j's values come from cell_bounds or state.
-fn wanted_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u32) -> bool {
-    let d = walker.pos - pos_j;
-    let spheres = walker.bound + bound_j + CONTACT_MARGIN;
-    let apart = abs(d) - walker.extent - extent_j;
-    return (walker.moves || moves_j == MOVES) && dot(d, d) <= spheres * spheres && all(apart <= vec3<f32>(CONTACT_MARGIN));
-}
-
-// Whether the walker and body j come within keep_margin() more than
-// wanted_bounds asks (`pairs_kept`): a superset of its pairs.
-fn near_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u32) -> bool {
-    let margin = CONTACT_MARGIN + keep_margin();
+// Whether the walker and body j come within `margin`: one of them moves and
+// their bounding spheres and grown world boxes come that near (the spheres
+// cut the boxes' corners). Every sum takes one term of each body, so either
+// walk gets the same bits; j's values come from cell_bounds or state.
+fn bounds_within(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u32, margin: f32) -> bool {
     let d = walker.pos - pos_j;
     let spheres = walker.bound + bound_j + margin;
     let apart = abs(d) - walker.extent - extent_j;
     return (walker.moves || moves_j == MOVES) && dot(d, d) <= spheres * spheres && all(apart <= vec3<f32>(margin));
 }
 
-// Whether this walk looks for pairs near (`pairs_kept`): only where the last
-// walks listed none; after any, the list is not kept (pairs_count says so).
+// Whether the walker and body j form a candidate pair: within CONTACT_MARGIN.
+fn wanted_bounds(pos_j: vec3<f32>, bound_j: f32, extent_j: vec3<f32>, moves_j: u32) -> bool {
+    return bounds_within(pos_j, bound_j, extent_j, moves_j, CONTACT_MARGIN);
+}
+
+// Whether this walk looks for pairs near, within keep_margin() more than it
+// lists (`pairs_kept`): only where the last walks listed none; after any,
+// the list is not kept (pairs_count says so).
 var<private> testing_near: bool;
 
 // Notes that this step's walks found a pair near.
 fn note_near() {
-    if (testing_near && atomicLoad(&status[STATUS_NEAR_NOW]) == 0u) {
+    if (atomicLoad(&status[STATUS_NEAR_NOW]) == 0u) {
         atomicStore(&status[STATUS_NEAR_NOW], 1u);
     }
 }
 
+// Whether body i, its bounds centred at `centre`, moves and comes within `margin` of the ground.
+fn ground_within(i: u32, centre: vec3<f32>, margin: f32) -> bool {
+    return params.has_ground != 0u && pair_meta[i].moves == MOVES
+        && centre.y - pair_meta[i].extent.y - params.ground_height <= margin;
+}
+
 // Whether body i, its bounds centred at `centre`, is near enough the ground for a ground pair.
 fn wants_ground(i: u32, centre: vec3<f32>) -> bool {
-    return params.has_ground != 0u && pair_meta[i].moves == MOVES
-        && centre.y - pair_meta[i].extent.y - params.ground_height <= CONTACT_MARGIN;
+    return ground_within(i, centre, CONTACT_MARGIN);
 }
 
 // Whether the walker owns its pair with body j (box size `size_j`) when one is
@@ -168,7 +169,7 @@ fn visit_places(first: u32, end: u32, c: vec3<i32>, any_cell: bool, above: u32, 
             if (wanted_bounds(cb.pos, cb.bound, cb.extent, moves_j)) {
                 take(j);
             }
-            if (testing_near && near_bounds(cb.pos, cb.bound, cb.extent, moves_j)) {
+            if (testing_near && bounds_within(cb.pos, cb.bound, cb.extent, moves_j, CONTACT_MARGIN + keep_margin())) {
                 note_near();
             }
         }
@@ -222,8 +223,7 @@ fn walk(i: u32) {
     owned = 0u;
     trips = 0u;
     // a fast walker, or a body near the ground, keeps the list from being kept
-    let ground_gap = walker.pos.y - walker.extent.y - params.ground_height;
-    if (testing_near && (walker.fast || (params.has_ground != 0u && walker.moves && ground_gap <= CONTACT_MARGIN + keep_margin()))) {
+    if (testing_near && (walker.fast || ground_within(i, walker.pos, CONTACT_MARGIN + keep_margin()))) {
         note_near();
     }
     if (wants_ground(i, walker.pos)) {

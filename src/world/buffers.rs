@@ -230,15 +230,9 @@ impl WorldData {
         write(hull_buf, 0, bytemuck::cast_slice(hulls));
         write(joint_start, 0, bytemuck::cast_slice(&joints.starts));
         write(joint_refs, 0, bytemuck::cast_slice(&joints.refs));
-        // the grid's part of `sorted` holds the other bodies, n - large of them,
-        // in index order until the first walks sort them (grid_count takes the
-        // bodies in that order)
-        let in_grid: Vec<u32> = {
-            let mut out = vec![true; states.len()];
-            large.iter().for_each(|&j| out[j as usize] = false);
-            (0..states.len() as u32).filter(|&i| out[i as usize]).collect()
-        };
-        write(self.sorted(), 0, bytemuck::cast_slice(&in_grid));
+        // the grid's part of `sorted` holds the other bodies, n - large of them
+        // (grid_count reads the grid's order only once a walk has written it:
+        // `status.near` is 1 until then)
         write(self.sorted(), 4 * (states.len() - large.len()) as u64, bytemuck::cast_slice(large));
     }
 
