@@ -207,6 +207,22 @@ fn pairs_kept() -> bool {
     return atomicLoad(&status[STATUS_WALK]) == 0u;
 }
 
+// Sizes the passes that run only where a step walks (the grid's scans,
+// scatter and sort, the pair scan and writes), in the order of `Over::walk`:
+// over the buckets, the grid scan's blocks, the bodies, the pair scan's
+// blocks, one workgroup; or to nothing, so that a step that keeps its list
+// pays no invocation for them.
+fn size_walk_passes(walks: bool) {
+    let buckets = (params.hash_size + WORKGROUP - 1u) / WORKGROUP;
+    let scan_blocks = (params.hash_size + SCAN_SPAN - 1u) / SCAN_SPAN;
+    let bodies = (params.body_count + WORKGROUP - 1u) / WORKGROUP;
+    let body_scan_blocks = (params.body_count + SCAN_SPAN - 1u) / SCAN_SPAN;
+    let sizes = array<u32, 5>(buckets, scan_blocks, bodies, body_scan_blocks, 1u);
+    for (var k = 0u; k < 5u; k = k + 1u) {
+        atomicStore(&status[STATUS_WALK_DISPATCHES + 3u * k], select(0u, max(sizes[k], 1u), walks));
+    }
+}
+
 // The margin (m) beyond CONTACT_MARGIN within which the walks note a pair as
 // near: within 0.001 of a cell, which a walk's neighbouring cells still cover
 // (`fast_size` in grid.wgsl leaves that slack).

@@ -105,6 +105,10 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&status[STATUS_TOUCHING_DISPATCH], 0u);
         // the bodies kept out of the grid have no place in it to compare with
         atomicMax(&status[STATUS_WALK], u32(params.large_count != 0u));
+        // (walking already: the other invocations only ever set it)
+        if (atomicLoad(&status[STATUS_WALK]) != 0u) {
+            size_walk_passes(true);
+        }
     }
     if (gid.x >= params.body_count) {
         return;
@@ -144,6 +148,7 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         let same = (seen.body & BODY_BITS) == i && moves_code == moves_before;
         if (!(within && same) && atomicLoad(&status[STATUS_WALK]) == 0u) {
             atomicStore(&status[STATUS_WALK], 1u);
+            size_walk_passes(true);
         }
     }
     // the movers' walks look for sleepers behind them too; one store sets it
@@ -203,26 +208,11 @@ fn scan_written(k: u32) -> vec2<u32> {
     return vec2<u32>(cell_start[k], 0u);
 }
 
-// pairs_kept(), read once by a workgroup that meets barriers
-var<workgroup> scan_kept: u32;
-
-// Whether the scan is not needed this step (`pairs_kept`), the same for the
-// whole workgroup; every invocation must call it.
-fn scan_skipped(lid: u32) -> bool {
-    if (lid == 0u) {
-        scan_kept = u32(pairs_kept());
-    }
-    return workgroupUniformLoad(&scan_kept) != 0u;
-}
-
 // A block is SCAN_SPAN = SCAN_BLOCK x SCAN_RUN elements: each invocation sums
 // a run of SCAN_RUN in turn, then the workgroup scans the runs' totals (its
 // barriers, not the sums, are what such a pass costs on lavapipe).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_id) wid: vec3<u32>) {
-    if (scan_skipped(lid.x)) {
-        return;
-    }
     let first = wid.x * SCAN_SPAN + lid.x * SCAN_RUN;
     let end = min(first + SCAN_RUN, scan_len());
     var total = vec2<u32>(0u);
@@ -267,7 +257,7 @@ fn finish_scan(sum: vec2<u32>) {
 // invocation scanning a run of blocks first (none for a scan of one block).
 @compute @workgroup_size(SCAN_BLOCK)
 fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
-    if (scan_len() <= SCAN_SPAN || scan_skipped(lid.x)) {
+    if (scan_len() <= SCAN_SPAN) {
         return;
     }
     let blocks = (scan_len() + SCAN_SPAN - 1u) / SCAN_SPAN;
@@ -298,7 +288,7 @@ fn scan_sums(@builtin(local_invocation_id) lid: vec3<u32>) {
 @compute @workgroup_size(WORKGROUP)
 fn scan_add(@builtin(global_invocation_id) gid: vec3<u32>) {
     let h = gid.x;
-    if (h < scan_len() && !pairs_kept()) {
+    if (h < scan_len()) {
         cell_start[h] = cell_start[h] + block_sums[h / SCAN_SPAN].x;
     }
 }
@@ -310,11 +300,6 @@ fn grid_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let h = bucket_of(cell_of(state_of(i).pos));
-    if (pairs_kept()) {
-        // the grid stays as the last walks saw it; the counts start again at 0
-        atomicStore(&cell_count[h], 0u);
-        return;
-    }
     // from the bucket's start as the count goes down, in arrival order
     sorted[params.body_count + cell_start[h + 1u] - atomicSub(&cell_count[h], 1u)] = i;
 }
@@ -339,7 +324,7 @@ fn grid_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
         let bound = CellBound(large_centre(j), pair_meta[j].bound, pair_meta[j].extent, j | (pair_meta[j].moves << MOVES_SHIFT));
         set_cell_bound(params.body_count - params.large_count + i, bound);
     }
-    if (i >= params.body_count || !in_grid(i) || pairs_kept()) {
+    if (i >= params.body_count || !in_grid(i)) {
         return;
     }
     let pos = state_of(i).pos;

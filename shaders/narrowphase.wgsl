@@ -311,6 +311,8 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
             atomicStore(&status[STATUS_NEAR_NOW], 0u);
         }
         atomicStore(&status[STATUS_WALK], atomicLoad(&status[STATUS_NEAR]));
+        // the walk's passes are sized anew by the next grid_count
+        size_walk_passes(false);
     }
     if (i >= params.body_count) {
         return;

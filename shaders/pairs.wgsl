@@ -284,7 +284,12 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         sorted[LISTED_RUN * params.body_count + gid.x] = NONE;
         sorted[TOUCHING_RUN * params.body_count + gid.x] = NONE;
         if (pairs_kept()) {
-            return; // the last walks' list, empty, stands
+            // the last walks' list, empty, stands, and so does the grid (its
+            // scans, scatter and sort do not run): the counts start again at 0
+            if (in_grid(i)) {
+                atomicStore(&cell_count[bucket_of(cell_of(state_of(i).pos))], 0u);
+            }
+            return;
         }
         // (the pairs the last walks counted: the scan has not yet written this step's)
         let listed_none = atomicLoad(&status[STATUS_PAIRS]) == 0u;
@@ -316,7 +321,7 @@ fn note_long_walks() {
 
 @compute @workgroup_size(WORKGROUP)
 fn pairs_write(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.body_count || pairs_kept()) {
+    if (gid.x >= params.body_count) {
         return;
     }
     let i = sorted[gid.x];

@@ -10,7 +10,11 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::limits::NO_FAULT;
 
-/// The status words, in buffer order (116 bytes). The host reads it back
+/// How many sizes the passes that run only where a step walks for pairs
+/// take (`Status::walk_dispatches`).
+pub const WALK_DISPATCHES: usize = 5;
+
+/// The status words, in buffer order (176 bytes). The host reads it back
 /// after each batch of steps (`World::fit_pools`), and on request.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -63,6 +67,11 @@ pub struct Status {
     /// grown box left the bounds the last walks saw by half `keep_margin`, or
     /// its `moves` changed. 0: the step keeps the last pair list, empty.
     pub walk: u32,
+    /// The indirect dispatches of the passes that run only where the step
+    /// walks (`Over::walk_index` orders them): at full size once the step
+    /// walks (grid_count), none as the step ends (contact_lists); copied
+    /// out after grid_count.
+    pub walk_dispatches: [[u32; 3]; WALK_DISPATCHES],
     /// 1 once a pair walk took so many loop trips that the driver may have cut it short (LOOP_TRIPS); never cleared.
     pub walks_cut: u32,
     /// 1 once a contact list's sort may have been cut short alike (contact_lists); never cleared.
@@ -104,6 +113,7 @@ impl Status {
         near: 1,
         near_now: 0,
         walk: 1,
+        walk_dispatches: [[0, 1, 1]; WALK_DISPATCHES],
         walks_cut: 0,
         lists_cut: 0,
     };
@@ -111,7 +121,7 @@ impl Status {
     /// The WGSL name and the first word of every field, in order: the
     /// shared constants (`shaders::shared_constants`) by which WGSL indexes
     /// the status words.
-    pub const WORDS: [(&'static str, u32); 21] = [
+    pub const WORDS: [(&'static str, u32); 22] = [
         ("STATUS_PAIRS", word!(pairs)),
         ("STATUS_PAIRS_MAX", word!(pairs_max)),
         ("STATUS_FAULT", word!(fault)),
@@ -131,6 +141,7 @@ impl Status {
         ("STATUS_NEAR", word!(near)),
         ("STATUS_NEAR_NOW", word!(near_now)),
         ("STATUS_WALK", word!(walk)),
+        ("STATUS_WALK_DISPATCHES", word!(walk_dispatches)),
         ("STATUS_WALKS_CUT", word!(walks_cut)),
         ("STATUS_LISTS_CUT", word!(lists_cut)),
     ];

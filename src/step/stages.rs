@@ -67,6 +67,31 @@ pub(crate) enum Over {
     /// Of those, the bodies with contacts (`touching_body`): sized alike
     /// (`Status::touching_dispatch`).
     Touching,
+    /// Where the step walks for pairs, the buckets, the grid scan's blocks,
+    /// the bodies, the pair scan's blocks or one workgroup; on a step that
+    /// keeps its empty pair list (`pairs_kept` in bindings.wgsl), nothing:
+    /// an indirect dispatch grid_count sizes (`Status::walk_dispatches`).
+    WalkBuckets,
+    WalkScanBlocks,
+    WalkBodies,
+    WalkBodyScanBlocks,
+    WalkOne,
+}
+
+impl Over {
+    /// A walk's dispatch: its place among `Status::walk_dispatches` (the
+    /// order `size_walk_passes` in bindings.wgsl writes them in), and what
+    /// it is over where the step walks.
+    pub(crate) fn walk(self) -> Option<(usize, Over)> {
+        Some(match self {
+            Over::WalkBuckets => (0, Over::Buckets),
+            Over::WalkScanBlocks => (1, Over::ScanBlocks),
+            Over::WalkBodies => (2, Over::Bodies),
+            Over::WalkBodyScanBlocks => (3, Over::BodyScanBlocks),
+            Over::WalkOne => (4, Over::One),
+            _ => return None,
+        })
+    }
 }
 
 /// What a stage does with the pose buffers.
@@ -179,18 +204,20 @@ pub(crate) const TABLE: [StageInfo; 25] = {
         S {
             reads: &[Params, Props, StateIn, CellCount, Status, Sorted, PairMeta, CellBounds, Hulls],
             writes: &[CellCount, Status, PairMeta],
+            // what the walk's passes are over this step, sized as the pass ends
+            copy_after: &[Over::WalkBuckets, Over::WalkScanBlocks, Over::WalkBodies, Over::WalkBodyScanBlocks, Over::WalkOne],
             ..S::row(Stage::GridCount, "grid_count", GRID_PASS, Broadphase)
         },
         S {
             entry_point: "scan_blocks",
-            over: Over::ScanBlocks,
+            over: Over::WalkScanBlocks,
             reads: SCAN_BLOCKS_READS,
             writes: SCAN_WRITES,
             ..S::row(Stage::GridScanBlocks, "grid_scan_blocks", GRID_PASS, Broadphase)
         },
         S {
             entry_point: "scan_sums",
-            over: Over::One,
+            over: Over::WalkOne,
             runs: Runs::EachStepOverManyBuckets,
             reads: SCAN_SUMS_READS,
             writes: SCAN_WRITES,
@@ -198,31 +225,33 @@ pub(crate) const TABLE: [StageInfo; 25] = {
         },
         S {
             entry_point: "scan_add",
-            over: Over::Buckets,
+            over: Over::WalkBuckets,
             runs: Runs::EachStepOverManyBuckets,
-            reads: &[Params, CellStart, BlockSums, Status],
+            reads: &[Params, CellStart, BlockSums],
             writes: &[CellStart],
             ..S::row(Stage::GridScanAdd, "grid_scan_add", GRID_PASS, Broadphase)
         },
         S {
-            reads: &[Params, Props, StateIn, CellCount, CellStart, Status],
+            over: Over::WalkBodies,
+            reads: &[Params, Props, StateIn, CellCount, CellStart],
             writes: &[CellCount, Sorted],
             ..S::row(Stage::GridScatter, "grid_scatter", GRID_PASS, Broadphase)
         },
         S {
-            reads: &[Params, Props, StateIn, CellStart, Sorted, PairMeta, Status, Hulls],
+            over: Over::WalkBodies,
+            reads: &[Params, Props, StateIn, CellStart, Sorted, PairMeta, Hulls],
             writes: &[Sorted, CellBounds],
             ..S::row(Stage::GridSort, "grid_sort", GRID_PASS, Broadphase)
         },
         S {
             reads: &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds, Hulls],
-            writes: &[Sorted, Pairs, Status, PairMeta, BodyPairs],
+            writes: &[CellCount, Sorted, Pairs, Status, PairMeta, BodyPairs],
             ..S::row(Stage::PairsCount, "pairs_count", PAIRS_PASS, Narrowphase)
         },
         S {
             entry_point: "scan_blocks",
             constants: SCAN_PAIRS,
-            over: Over::BodyScanBlocks,
+            over: Over::WalkBodyScanBlocks,
             reads: SCAN_BLOCKS_READS,
             writes: SCAN_WRITES,
             ..S::row(Stage::PairsScanBlocks, "pairs_scan_blocks", GRID_PASS, Narrowphase)
@@ -230,13 +259,14 @@ pub(crate) const TABLE: [StageInfo; 25] = {
         S {
             entry_point: "scan_sums",
             constants: SCAN_PAIRS,
-            over: Over::One,
+            over: Over::WalkOne,
             runs: Runs::EachStepOverManyBodies,
             reads: SCAN_SUMS_READS,
             writes: SCAN_WRITES,
             ..S::row(Stage::PairsScanSums, "pairs_scan_sums", GRID_PASS, Narrowphase)
         },
         S {
+            over: Over::WalkBodies,
             reads: &[Params, Props, StateIn, CellStart, BlockSums, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds, Hulls],
             writes: &[Pairs, Status, PairMeta, BodyPairs],
             ..S::row(Stage::PairsWrite, "pairs_write", PAIRS_PASS, Narrowphase)

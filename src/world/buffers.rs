@@ -7,7 +7,7 @@ use bytemuck::{Pod, Zeroable};
 use super::capacity::{pair_capacities, pool_parts};
 use super::encode::MAX_BATCH;
 use super::records::{hash_size, JointLists};
-use crate::gpu::status::Status;
+use crate::gpu::status::{Status, WALK_DISPATCHES};
 use crate::gpu::{types::*, Gpu};
 use crate::step::{Buffer, Over, Stage, StepPipelines};
 
@@ -83,6 +83,7 @@ pub(super) struct Dispatches {
     _pad2: u32,
     touching: [u32; 3],
     _pad3: u32,
+    walk: [[u32; 3]; WALK_DISPATCHES],
 }
 
 /// Where an indirect dispatch over `over` takes its size: its place in the
@@ -94,7 +95,11 @@ pub(super) fn indirect(over: Over) -> Option<(u64, u64)> {
         Over::Manifolds => (offset_of!(Dispatches, manifolds), offset_of!(Status, manifolds_dispatch)),
         Over::Listed => (offset_of!(Dispatches, listed), offset_of!(Status, listed_dispatch)),
         Over::Touching => (offset_of!(Dispatches, touching), offset_of!(Status, touching_dispatch)),
-        _ => return None,
+        _ => {
+            let (k, _) = over.walk()?;
+            let size = size_of::<[u32; 3]>();
+            (offset_of!(Dispatches, walk) + k * size, offset_of!(Status, walk_dispatches) + k * size)
+        }
     };
     Some((slot as u64, words as u64))
 }

@@ -117,7 +117,7 @@ impl World {
 
     /// Records one step's dispatches (`plan`, its substeps' Params from batch
     /// slot `first` on) in as few compute passes as the copies of the
-    /// indirect dispatch sizes allow (three): on lavapipe every pass costs
+    /// indirect dispatch sizes allow (four): on lavapipe every pass costs
     /// as much as a small dispatch (docs/step.md). `encode_pass` gives each
     /// dispatch a pass of its own, for `profile`'s timestamps.
     fn encode_step(&mut self, encoder: &mut wgpu::CommandEncoder, plan: &[(Stage, usize)], first: usize) {
@@ -147,9 +147,17 @@ impl World {
     /// any compute pass.
     fn copy_dispatch_sizes(&self, encoder: &mut wgpu::CommandEncoder, stage: Stage, before: bool) {
         let info = stage.info();
+        // (sizes side by side in both buffers go in one copy)
+        let mut runs: Vec<(u64, u64, u64)> = Vec::new();
         for &over in if before { info.copy_before } else { info.copy_after } {
             let (slot, words) = indirect(over).expect("copied sizes are of an indirect dispatch");
-            encoder.copy_buffer_to_buffer(&self.data.status, words, &self.data.dispatch, slot, DISPATCH_BYTES);
+            match runs.last_mut() {
+                Some((s, w, len)) if *s + *len == slot && *w + *len == words => *len += DISPATCH_BYTES,
+                _ => runs.push((slot, words, DISPATCH_BYTES)),
+            }
+        }
+        for (slot, words, len) in runs {
+            encoder.copy_buffer_to_buffer(&self.data.status, words, &self.data.dispatch, slot, len);
         }
     }
 
@@ -294,7 +302,7 @@ impl World {
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
             Over::IslandJoints => self.island_joints.div_ceil(WORKGROUP),
             Over::Paths => self.path_colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0).div_ceil(PATH_WORKGROUP),
-            Over::Pairs | Over::Manifolds | Over::Listed | Over::Touching => unreachable!("dispatched indirectly"),
+            _ => unreachable!("dispatched indirectly"),
         };
         n.max(1)
     }

@@ -4,8 +4,10 @@
 //! ball far away flying fast, whose move makes every step walk; the bodies
 //! they share end with the same bits.
 
-use verlet::gpu::types::BodyState;
+use verlet::gpu::types::{BodyState, SCAN_SPAN, WORKGROUP};
 use verlet::scenes::{box_body, sphere_body};
+use verlet::step::Stage;
+use verlet::world::plan_grid;
 use verlet::{scenes, Scene, World};
 
 use crate::common::world;
@@ -45,6 +47,26 @@ fn a_still_joint_grid_keeps_its_empty_list_to_the_same_bits() {
     let status = kept.read_status().unwrap();
     assert_eq!((status.near, status.walk, status.pairs), (0, 0, 0), "{status:?}");
     assert!(a == b, "the still grid's states differ from a run that walks every step");
+}
+
+/// The passes only a walk needs (the grid's scans, scatter and sort, the
+/// pair scan and writes) are dispatched at their size where a step walks,
+/// and at none where it keeps its list: `grid_count` sizes them.
+#[test]
+fn a_kept_step_dispatches_no_invocation_of_the_walk_s_passes() {
+    let scene = scenes::by_name("joint_grid", Some(10), 1).unwrap();
+    let Some((mut kept, _, _)) = both(&scene, 120) else { return };
+    let mut walked = world(&walking_every_step(&scene)).unwrap();
+    walked.step(120).unwrap();
+    for w in [&mut kept, &mut walked] {
+        w.run_stages(&[Stage::GridCount]).unwrap();
+    }
+    let sizes = |w: &World| w.read_status().unwrap().walk_dispatches;
+    assert_eq!(sizes(&kept), [[0, 1, 1]; 5], "a kept step");
+    let radii: Vec<f32> = walking_every_step(&scene).bodies.iter().map(|b| b.bounding_radius()).collect();
+    let (n, hash) = (radii.len() as u32, plan_grid(&radii).1.hash_size);
+    let full = [hash.div_ceil(WORKGROUP), hash.div_ceil(SCAN_SPAN), n.div_ceil(WORKGROUP), n.div_ceil(SCAN_SPAN), 1];
+    assert_eq!(sizes(&walked), full.map(|x| [x.max(1), 1, 1]), "a step that walks");
 }
 
 /// A box drifting at 0.5 mm a step towards another 3 cm away, with no

@@ -247,6 +247,7 @@ fn status_words_match_the_struct() {
         near => "STATUS_NEAR",
         near_now => "STATUS_NEAR_NOW",
         walk => "STATUS_WALK",
+        walk_dispatches => "STATUS_WALK_DISPATCHES",
         walks_cut => "STATUS_WALKS_CUT",
         lists_cut => "STATUS_LISTS_CUT",
     );
