@@ -598,9 +598,10 @@ fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
 }
 
 // A joint's PATH_SLOT words of path_scratch: its pivot's inverse, the
-// eliminated gap in the w's (3); its coupling to the joint before, the first
-// word's w saying which of its ends it shares with that joint (0 none, 1 its
-// body, 2 its partner) (3).
+// eliminated gap in the w's (3); which of its ends it shares with the joint
+// before (0 none, 1 its body, 2 its partner) (1). Its coupling to that joint
+// is not kept: the way back forms it again from the same poses, a load and a
+// store fewer a joint, which are what a path's loop costs on lavapipe.
 
 // Whether every joint of a path is closed within JOINT_SETTLED, as the
 // swept passes end, or within what its ends' f32 positions can tell apart
@@ -680,16 +681,16 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         path_scratch[at] = vec4<f32>(pivot[0], gap.x);
         path_scratch[at + 1u] = vec4<f32>(pivot[1], gap.y);
         path_scratch[at + 2u] = vec4<f32>(pivot[2], gap.z);
-        path_scratch[at + 3u] = vec4<f32>(coupling[0], f32(link.x));
-        path_scratch[at + 4u] = vec4<f32>(coupling[1], 0.0);
-        path_scratch[at + 5u] = vec4<f32>(coupling[2], 0.0);
+        path_scratch[at + 3u] = vec4<f32>(f32(link.x), 0.0, 0.0, 0.0);
         held[0] = a;
         held[1] = b;
         prev = pj;
     }
     // back: each joint's push, each body moved once all its pushes are known
     // (the body shared with the joint before waits for it in `wait`)
-    var after = vec3<f32>(0.0);      // the coupling of the joint after, times its push, transposed
+    var after_push = vec3<f32>(0.0); // the push of the joint after
+    var after_r = vec3<f32>(0.0);    // its anchor on the body it shares with this joint (`wait`)
+    var after_link = 0u;             // which of its ends that is (0: none)
     var wait = PathEnd(NONE, BodyState(), 0.0, mat3x3<f32>());
     var wait_push = vec3<f32>(0.0);  // summed push on `wait`
     var wait_turn = vec3<f32>(0.0);  // and its moment
@@ -699,12 +700,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         let w0 = path_scratch[at];
         let w1 = path_scratch[at + 1u];
         let w2 = path_scratch[at + 2u];
-        let c0 = path_scratch[at + 3u];
-        let c1 = path_scratch[at + 4u];
-        let c2 = path_scratch[at + 5u];
-        let push = mat3x3<f32>(w0.xyz, w1.xyz, w2.xyz) * (vec3<f32>(w0.w, w1.w, w2.w) - after);
-        after = vec3<f32>(dot(c0.xyz, push), dot(c1.xyz, push), dot(c2.xyz, push));
-        let shares = u32(c0.w);
+        let shares = u32(path_scratch[at + 3u].x);
         let j = joint_refs[first + k];
         var kept: array<PathEnd, 2>;
         kept[0] = wait;
@@ -712,6 +708,19 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         let a = path_end(j.body, kept);
         let b = path_end(j.partner, kept);
         let r = joint_anchors(j, a.s.rot, b.s.rot);
+        // the joint after's coupling to this one, as the elimination formed it,
+        // times its push, transposed
+        var after = vec3<f32>(0.0);
+        if (after_link != 0u) {
+            let there = select(2u, 1u, a.i == wait.i);
+            let sign = select(-1.0, 1.0, after_link == there);
+            let coupling = end_response(wait, after_r, select(r[1], r[0], there == 1u)) * sign;
+            after = vec3<f32>(dot(coupling[0], after_push), dot(coupling[1], after_push), dot(coupling[2], after_push));
+        }
+        let push = mat3x3<f32>(w0.xyz, w1.xyz, w2.xyz) * (vec3<f32>(w0.w, w1.w, w2.w) - after);
+        after_push = push;
+        after_link = shares;
+        after_r = select(r[1], r[0], shares == 1u);
         // the body the joint after left waiting, before this joint's end takes its place
         let waited = wait.i;
         let waited_push = wait_push;
