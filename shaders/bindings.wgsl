@@ -208,7 +208,8 @@ fn pairs_kept() -> bool {
 }
 
 // Sizes the passes that run only where a step walks (the grid's scans,
-// scatter and sort, the pair scan and writes), in the order of `Over::walk`:
+// scatter and sort, the pair scan and writes, and the ground's narrowphase,
+// which a kept list, empty, gives no pair), in the order of `Over::walk`:
 // over the buckets, the grid scan's blocks, the bodies, the pair scan's
 // blocks, one workgroup; or to nothing, so that a step that keeps its list
 // pays no invocation for them.

@@ -287,6 +287,8 @@ pub(crate) const TABLE: [StageInfo; 25] = {
             ..S::row(Stage::NarrowphaseHull, "narrowphase_hull", NARROWPHASE_PASS, Narrowphase)
         },
         S {
+            // a kept list is empty: no ground pair to test
+            over: Over::WalkBodies,
             reads: &[Params, Props, StateIn, Pairs, Manifolds, Status, PairMeta, BodyPairs, Points],
             writes: POOL_WRITES,
             ..S::row(Stage::NarrowphaseGround, "narrowphase_ground", NARROWPHASE_PASS, Narrowphase)
