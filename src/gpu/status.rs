@@ -68,7 +68,7 @@ pub struct Status {
     /// its `moves` changed. 0: the step keeps the last pair list, empty.
     pub walk: u32,
     /// The indirect dispatches of the passes that run only where the step
-    /// walks (`Over::walk_index` orders them): at full size once the step
+    /// walks (`Over::walk` orders them): at full size once the step
     /// walks (grid_count), none as the step ends (contact_lists); copied
     /// out after grid_count.
     pub walk_dispatches: [[u32; 3]; WALK_DISPATCHES],

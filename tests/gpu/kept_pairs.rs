@@ -50,8 +50,9 @@ fn a_still_joint_grid_keeps_its_empty_list_to_the_same_bits() {
 }
 
 /// The passes only a walk needs (the grid's scans, scatter and sort, the
-/// pair scan and writes, the ground's narrowphase) are dispatched at their size where a step walks,
-/// and at none where it keeps its list: `grid_count` sizes them.
+/// pair scan and writes, the ground's narrowphase) are dispatched at their
+/// size where a step walks, and at none where it keeps its list:
+/// `grid_count` sizes them.
 #[test]
 fn a_kept_step_dispatches_no_invocation_of_the_walk_s_passes() {
     let scene = scenes::by_name("joint_grid", Some(10), 1).unwrap();
