@@ -40,13 +40,6 @@ pub enum Stage {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Over {
     Bodies,
-    Buckets,
-    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` buckets.
-    ScanBlocks,
-    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` bodies.
-    BodyScanBlocks,
-    /// A single workgroup.
-    One,
     /// The candidate pairs: an indirect dispatch whose size the pair scan
     /// wrote (`Status::pairs_dispatch`).
     Pairs,
@@ -67,28 +60,32 @@ pub(crate) enum Over {
     /// Of those, the bodies with contacts (`touching_body`): sized alike
     /// (`Status::touching_dispatch`).
     Touching,
-    /// Where the step walks for pairs, the buckets, the grid scan's blocks,
-    /// the bodies, the pair scan's blocks or one workgroup; on a step that
-    /// keeps its empty pair list (`pairs_kept` in bindings.wgsl), nothing:
-    /// an indirect dispatch grid_count sizes (`Status::walk_dispatches`).
+    // The passes only a step that walks for pairs needs: on a step that
+    // keeps its empty pair list (`pairs_kept` in bindings.wgsl) they are
+    // dispatched at no size. Indirect dispatches grid_count sizes
+    // (`Status::walk_dispatches`, `size_walk_passes` in bindings.wgsl).
+    /// The grid's buckets.
     WalkBuckets,
+    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` buckets.
     WalkScanBlocks,
+    /// The bodies.
     WalkBodies,
+    /// One workgroup of `SCAN_BLOCK` per block of `SCAN_SPAN` bodies.
     WalkBodyScanBlocks,
+    /// A single workgroup.
     WalkOne,
 }
 
 impl Over {
     /// A walk's dispatch: its place among `Status::walk_dispatches` (the
-    /// order `size_walk_passes` in bindings.wgsl writes them in), and what
-    /// it is over where the step walks.
-    pub(crate) fn walk(self) -> Option<(usize, Over)> {
+    /// order `size_walk_passes` in bindings.wgsl writes them in).
+    pub(crate) fn walk(self) -> Option<usize> {
         Some(match self {
-            Over::WalkBuckets => (0, Over::Buckets),
-            Over::WalkScanBlocks => (1, Over::ScanBlocks),
-            Over::WalkBodies => (2, Over::Bodies),
-            Over::WalkBodyScanBlocks => (3, Over::BodyScanBlocks),
-            Over::WalkOne => (4, Over::One),
+            Over::WalkBuckets => 0,
+            Over::WalkScanBlocks => 1,
+            Over::WalkBodies => 2,
+            Over::WalkBodyScanBlocks => 3,
+            Over::WalkOne => 4,
             _ => return None,
         })
     }

@@ -96,7 +96,7 @@ pub(super) fn indirect(over: Over) -> Option<(u64, u64)> {
         Over::Listed => (offset_of!(Dispatches, listed), offset_of!(Status, listed_dispatch)),
         Over::Touching => (offset_of!(Dispatches, touching), offset_of!(Status, touching_dispatch)),
         _ => {
-            let (k, _) = over.walk()?;
+            let k = over.walk()?;
             let size = size_of::<[u32; 3]>();
             (offset_of!(Dispatches, walk) + k * size, offset_of!(Status, walk_dispatches) + k * size)
         }

@@ -295,10 +295,6 @@ impl World {
     fn workgroups(&self, over: Over) -> u32 {
         let n = match over {
             Over::Bodies => self.body_count.div_ceil(WORKGROUP),
-            Over::Buckets => self.grid.hash_size.div_ceil(WORKGROUP),
-            Over::ScanBlocks => self.grid.hash_size.div_ceil(SCAN_SPAN),
-            Over::BodyScanBlocks => self.body_count.div_ceil(SCAN_SPAN),
-            Over::One => 1,
             Over::Islands => self.island_count.div_ceil(WORKGROUP),
             Over::IslandJoints => self.island_joints.div_ceil(WORKGROUP),
             Over::Paths => self.path_colours.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0).div_ceil(PATH_WORKGROUP),
