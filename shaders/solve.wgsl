@@ -609,10 +609,17 @@ fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
 // its solve would move nothing that matters. Most solves of a path the other
 // colour barely moved, or that the substep's first solve left closed, end here.
 fn path_settled(first: u32, end: u32) -> bool {
+    // the body a joint shares with the one before is not loaded again
+    var held = vec2<u32>(NONE);
+    var kept: array<BodyState, 2>;
     for (var k = first; k < end; k = k + 1u) {
         let j = joint_refs[k];
-        let sa = out_state(j.body);
-        let sb = out_state(select(j.body, j.partner, j.partner != WORLD));
+        let b = select(j.body, j.partner, j.partner != WORLD);
+        let sa = held_or_loaded(j.body, held, kept);
+        let sb = held_or_loaded(b, held, kept);
+        held = vec2<u32>(j.body, b);
+        kept[0] = sa;
+        kept[1] = sb;
         // remainder_unit is 1/512 of a coordinate's spacing
         let unit = max(remainder_unit(sa.pos), remainder_unit(sb.pos));
         let rounding = 1024.0 * max(unit.x, max(unit.y, unit.z));
