@@ -623,7 +623,12 @@ fn path_settled(first: u32, end: u32) -> bool {
         // remainder_unit is 1/512 of a coordinate's spacing
         let unit = max(remainder_unit(sa.pos), remainder_unit(sb.pos));
         let rounding = 1024.0 * max(unit.x, max(unit.y, unit.z));
-        if (length(path_joint(j, sa, sb).close) >= JOINT_SETTLED + rounding) {
+        let limit = JOINT_SETTLED + rounding;
+        // the part of a gap to close is never longer than the gap, so a gap
+        // shorter than the limit needs no more (the anchors as joint_gap has them)
+        let r = joint_anchors(j, sa.rot, sb.rot);
+        let gap = select(j.local_partner, sb.pos + r[1], j.partner != WORLD) - (sa.pos + r[0]);
+        if (length(gap) >= limit && length(path_joint(j, sa, sb).close) >= limit) {
             return false;
         }
     }
