@@ -598,10 +598,10 @@ fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
 }
 
 // A joint's PATH_SLOT words of path_scratch: its pivot's inverse, the
-// eliminated gap in the w's (3); which of its ends it shares with the joint
-// before (0 none, 1 its body, 2 its partner) (1). Its coupling to that joint
-// is not kept: the way back forms it again from the same poses, a load and a
-// store fewer a joint, which are what a path's loop costs on lavapipe.
+// eliminated gap in the w's. Its coupling to the joint before, and which of
+// its ends it shares with it, are not kept: the way back works them out
+// again from the same poses and records, a load and a store fewer a joint,
+// which are what a path's loop costs on lavapipe.
 
 // Whether every joint of a path is closed within JOINT_SETTLED, as the
 // swept passes end, or within what its ends' f32 positions can tell apart
@@ -693,7 +693,6 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         path_scratch[at] = vec4<f32>(pivot[0], gap.x);
         path_scratch[at + 1u] = vec4<f32>(pivot[1], gap.y);
         path_scratch[at + 2u] = vec4<f32>(pivot[2], gap.z);
-        path_scratch[at + 3u] = vec4<f32>(f32(link.x), 0.0, 0.0, 0.0);
         held[0] = a;
         held[1] = b;
         prev = pj;
@@ -712,13 +711,23 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         let w0 = path_scratch[at];
         let w1 = path_scratch[at + 1u];
         let w2 = path_scratch[at + 2u];
-        let shares = u32(path_scratch[at + 3u].x);
         let j = joint_refs[first + k];
         var kept: array<PathEnd, 2>;
         kept[0] = wait;
         kept[1].i = NONE;
         let a = path_end(j.body, kept);
         let b = path_end(j.partner, kept);
+        // which of its ends it shares with the joint before, as the
+        // elimination found it (0 none, 1 its body, 2 its partner)
+        var shares = 0u;
+        if (k > 0u) {
+            let before = vec2<u32>(joint_refs[first + k - 1u].body, joint_refs[first + k - 1u].partner);
+            if (a.i != NONE && any(before == vec2<u32>(a.i))) {
+                shares = 1u;
+            } else if (b.i != NONE && any(before == vec2<u32>(b.i))) {
+                shares = 2u;
+            }
+        }
         let r = joint_anchors(j, a.s.rot, b.s.rot);
         // the joint after's coupling to this one, as the elimination formed it,
         // times its push, transposed

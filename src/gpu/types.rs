@@ -330,9 +330,9 @@ pub const PATH_WORKGROUP: u32 = 8;
 
 /// vec4 words of `path_scratch` a joint of the paths takes (`PATH_SLOT` in
 /// WGSL; shaders/solve.wgsl's `solve_path`): its pivot's inverse with the
-/// eliminated gap (3), which of its ends it shares with the joint before
-/// (1). The coupling between the two is formed again on the way back.
-pub const PATH_SLOT: u32 = 4;
+/// eliminated gap. Its coupling to the joint before, and which end it
+/// shares with it, are worked out again on the way back.
+pub const PATH_SLOT: u32 = 3;
 
 /// Byte stride between the per-step `Params` slots of a batch: the
 /// uniform-buffer offset alignment WebGPU guarantees to work everywhere.
