@@ -544,7 +544,9 @@ struct PathEnd {
     w: mat3x3<f32>,
 }
 
-fn path_end(i: u32, held: array<PathEnd, 2>) -> PathEnd {
+// The way back reads no previous orientation (`back`): it is neither loaded
+// there nor stored again (set_moved).
+fn path_end(i: u32, held: array<PathEnd, 2>, back: bool) -> PathEnd {
     if (i == WORLD) {
         return PathEnd(NONE, BodyState(), 0.0, mat3x3<f32>());
     }
@@ -554,12 +556,26 @@ fn path_end(i: u32, held: array<PathEnd, 2>) -> PathEnd {
     if (held[1].i == i) {
         return held[1];
     }
-    let s = out_state(i);
+    var s: BodyState;
+    if (back) {
+        let w = state_out[i];
+        s = BodyState(w.a.xyz, w.a.w, w.b.xyz, bitcast<u32>(w.b.w), w.rot, vec4<f32>(0.0));
+    } else {
+        s = out_state(i);
+    }
     let p = props_of(i);
     if (is_fixed(p)) {
         return PathEnd(NONE, s, 0.0, mat3x3<f32>());
     }
     return PathEnd(i, s, p.inv_inertia.w, world_inv_inertia(quat_to_mat(s.rot), p.inv_inertia.xyz));
+}
+
+// Body i's pose as the way back moved it: all but its previous orientation,
+// which the way back does not change.
+fn set_moved(i: u32, s: BodyState) {
+    state_out[i].a = vec4<f32>(s.pos, s.rest_time);
+    state_out[i].b = vec4<f32>(s.disp, bitcast<f32>(s.pos_low));
+    state_out[i].rot = s.rot;
 }
 
 // [v]x: skew(v) * u = cross(v, u).
@@ -611,28 +627,47 @@ fn path_joint(j: JointRef, sa: BodyState, sb: BodyState) -> PathJoint {
 fn path_settled(first: u32, end: u32) -> bool {
     // the body a joint shares with the one before is not loaded again
     var held = vec2<u32>(NONE);
-    var kept: array<BodyState, 2>;
+    var kept: array<Placed, 2>;
     for (var k = first; k < end; k = k + 1u) {
         let j = joint_refs[k];
         let b = select(j.body, j.partner, j.partner != WORLD);
-        let sa = held_or_loaded(j.body, held, kept);
-        let sb = held_or_loaded(b, held, kept);
+        let pa = placed_or_loaded(j.body, held, kept);
+        let pb = placed_or_loaded(b, held, kept);
         held = vec2<u32>(j.body, b);
-        kept[0] = sa;
-        kept[1] = sb;
+        kept[0] = pa;
+        kept[1] = pb;
         // remainder_unit is 1/512 of a coordinate's spacing
-        let unit = max(remainder_unit(sa.pos), remainder_unit(sb.pos));
+        let unit = max(remainder_unit(pa.pos), remainder_unit(pb.pos));
         let rounding = 1024.0 * max(unit.x, max(unit.y, unit.z));
         let limit = JOINT_SETTLED + rounding;
         // the part of a gap to close is never longer than the gap, so a gap
-        // shorter than the limit needs no more (the anchors as joint_gap has them)
-        let r = joint_anchors(j, sa.rot, sb.rot);
-        let gap = select(j.local_partner, sb.pos + r[1], j.partner != WORLD) - (sa.pos + r[0]);
-        if (length(gap) >= limit && length(path_joint(j, sa, sb).close) >= limit) {
+        // shorter than the limit needs no more, nor its ends' previous poses
+        // (the anchors as joint_gap has them)
+        let r = joint_anchors(j, pa.rot, pb.rot);
+        let gap = select(j.local_partner, pb.pos + r[1], j.partner != WORLD) - (pa.pos + r[0]);
+        if (length(gap) >= limit && length(path_joint(j, out_state(j.body), out_state(b)).close) >= limit) {
             return false;
         }
     }
     return true;
+}
+
+// A body's position and orientation, all that a settled joint's gap reads.
+struct Placed {
+    pos: vec3<f32>,
+    rot: vec4<f32>,
+}
+
+// Body i's position and orientation: from the registers if the joint before
+// holds it (held, kept), else from memory (two of its pose's four words).
+fn placed_or_loaded(i: u32, held: vec2<u32>, kept: array<Placed, 2>) -> Placed {
+    if (held[0] == i) {
+        return kept[0];
+    }
+    if (held[1] == i) {
+        return kept[1];
+    }
+    return Placed(state_out[i].a.xyz, state_out[i].rot);
 }
 
 // One direct solve of a chain, or of a path cut from a larger island (a
@@ -656,8 +691,8 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
     var prev = PathJoint(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var k = 0u; k < n; k = k + 1u) {
         let j = joint_refs[first + k];
-        let a = path_end(j.body, held);
-        let b = path_end(j.partner, held);
+        let a = path_end(j.body, held, false);
+        let b = path_end(j.partner, held, false);
         let pj = path_joint(j, a.s, b.s);
         var m = end_response(a, pj.ra, pj.ra) + end_response(b, pj.rb, pj.rb);
         // the body this joint shares with the one before (x: which end here, y: there)
@@ -715,8 +750,8 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         var kept: array<PathEnd, 2>;
         kept[0] = wait;
         kept[1].i = NONE;
-        let a = path_end(j.body, kept);
-        let b = path_end(j.partner, kept);
+        let a = path_end(j.body, kept, true);
+        let b = path_end(j.partner, kept, true);
         // which of its ends it shares with the joint before, as the
         // elimination found it (0 none, 1 its body, 2 its partner)
         var shares = 0u;
@@ -770,7 +805,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
                 x.s.pos = x.s.pos + dx;
                 x.s.disp = x.s.disp + dx;
                 x.s.rot = quat_add_rotation(x.s.rot, x.w * turn);
-                set_state(x.i, x.s);
+                set_moved(x.i, x.s);
             }
         }
         if (shares == 0u) {
