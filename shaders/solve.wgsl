@@ -558,8 +558,7 @@ fn path_end(i: u32, held: array<PathEnd, 2>, back: bool) -> PathEnd {
     }
     var s: BodyState;
     if (back) {
-        let w = state_out[i];
-        s = BodyState(w.a.xyz, w.a.w, w.b.xyz, bitcast<u32>(w.b.w), w.rot, vec4<f32>(0.0));
+        s = state_from(StateWords(state_out[i].a, state_out[i].b, state_out[i].rot, vec4<f32>(0.0)));
     } else {
         s = out_state(i);
     }
