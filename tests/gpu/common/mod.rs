@@ -1,29 +1,39 @@
-//! Shared by the GPU tests: one adapter per test binary, and small helpers.
+//! Shared by the GPU tests: two devices on the adapter, and small helpers.
 #![allow(dead_code)]
 
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
 
 use verlet::gpu::Gpu;
 use verlet::{Scene, World};
 
-/// The shared GPU, or None (after a loud message) when no adapter exists and
-/// `CI` is not set. Under CI a missing adapter fails the test.
+/// One of the two shared GPUs, or None (after a loud message) when no
+/// adapter exists and `CI` is not set. Under CI a missing adapter fails the
+/// test. The test threads take the two in turn and each keeps its own, so
+/// two tests running side by side have a queue each and neither's readbacks
+/// wait for the other's steps.
 pub fn gpu() -> Option<Arc<Gpu>> {
-    static GPU: OnceLock<Option<Arc<Gpu>>> = OnceLock::new();
-    GPU.get_or_init(|| match Gpu::new() {
-        Ok(gpu) => Some(Arc::new(gpu)),
-        Err(e) => {
-            if std::env::var_os("CI").is_some() {
-                panic!("CI is set but no GPU adapter was found: {e}");
+    static GPUS: [OnceLock<Option<Arc<Gpu>>>; 2] = [OnceLock::new(), OnceLock::new()];
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    thread_local! {
+        static MINE: usize = NEXT.fetch_add(1, Ordering::Relaxed) % 2;
+    }
+    let k = MINE.with(|&k| k);
+    GPUS[k]
+        .get_or_init(|| match Gpu::new() {
+            Ok(gpu) => Some(Arc::new(gpu)),
+            Err(e) => {
+                if std::env::var_os("CI").is_some() {
+                    panic!("CI is set but no GPU adapter was found: {e}");
+                }
+                eprintln!("\n!!!!! SKIPPING GPU TEST: no adapter ({e}) !!!!!\n");
+                None
             }
-            eprintln!("\n!!!!! SKIPPING GPU TEST: no adapter ({e}) !!!!!\n");
-            None
-        }
-    })
-    .clone()
+        })
+        .clone()
 }
 
-/// A world on the shared GPU, or None when the test must skip.
+/// A world on this test's GPU, or None when the test must skip.
 pub fn world(scene: &Scene) -> Option<World> {
     let gpu = gpu()?;
     Some(World::with_gpu(gpu, scene).expect("scene uploads"))
