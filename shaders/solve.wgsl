@@ -669,6 +669,25 @@ fn placed_or_loaded(i: u32, held: vec2<u32>, kept: array<Placed, 2>) -> Placed {
     return Placed(state_out[i].a.xyz, state_out[i].rot);
 }
 
+// Which end of a joint (its ends a and b: NONE unless they move) it shares
+// with the joint before (that joint's ends), and which end there:
+// x here, y there, each 1 for a joint's body, 2 for its partner, 0 for none.
+fn shared_end(a: u32, b: u32, before: vec2<u32>) -> vec2<u32> {
+    if (a != NONE && a == before.x) {
+        return vec2<u32>(1u, 1u);
+    }
+    if (a != NONE && a == before.y) {
+        return vec2<u32>(1u, 2u);
+    }
+    if (b != NONE && b == before.x) {
+        return vec2<u32>(2u, 1u);
+    }
+    if (b != NONE && b == before.y) {
+        return vec2<u32>(2u, 2u);
+    }
+    return vec2<u32>(0u);
+}
+
 // One direct solve of a chain, or of a path cut from a larger island (a
 // chain too: each joint shares one body with the next): the 3D gaps of all
 // its joints closed at once, as the linear system of their pushes (block
@@ -694,17 +713,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         let b = path_end(j.partner, held, false);
         let pj = path_joint(j, a.s, b.s);
         var m = end_response(a, pj.ra, pj.ra) + end_response(b, pj.rb, pj.rb);
-        // the body this joint shares with the one before (x: which end here, y: there)
-        var link = vec2<u32>(0u);
-        if (a.i != NONE && a.i == held[0].i) {
-            link = vec2<u32>(1u, 1u);
-        } else if (a.i != NONE && a.i == held[1].i) {
-            link = vec2<u32>(1u, 2u);
-        } else if (b.i != NONE && b.i == held[0].i) {
-            link = vec2<u32>(2u, 1u);
-        } else if (b.i != NONE && b.i == held[1].i) {
-            link = vec2<u32>(2u, 2u);
-        }
+        let link = shared_end(a.i, b.i, vec2<u32>(held[0].i, held[1].i));
         var coupling = mat3x3<f32>();
         if (link.x != 0u) {
             var x = b;
@@ -752,15 +761,11 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         let a = path_end(j.body, kept, true);
         let b = path_end(j.partner, kept, true);
         // which of its ends it shares with the joint before, as the
-        // elimination found it (0 none, 1 its body, 2 its partner)
+        // elimination found it (a moving end matches that joint's record)
         var shares = 0u;
         if (k > 0u) {
-            let before = vec2<u32>(joint_refs[first + k - 1u].body, joint_refs[first + k - 1u].partner);
-            if (a.i != NONE && any(before == vec2<u32>(a.i))) {
-                shares = 1u;
-            } else if (b.i != NONE && any(before == vec2<u32>(b.i))) {
-                shares = 2u;
-            }
+            let before = joint_refs[first + k - 1u];
+            shares = shared_end(a.i, b.i, vec2<u32>(before.body, before.partner)).x;
         }
         let r = joint_anchors(j, a.s.rot, b.s.rot);
         // the joint after's coupling to this one, as the elimination formed it,
