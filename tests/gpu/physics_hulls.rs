@@ -1,7 +1,8 @@
 //! Hulls with known answers: a tetrahedron rests on a face and one tipped
 //! onto an edge falls onto one, a slab tipped toward the corner its ground
 //! manifold left out keeps it out of the ground, a pile of rocks settles
-//! and sleeps without passing through the ground or each other, and cubes
+//! and sleeps without passing through the ground or each other (and forty
+//! piles of other rocks all but a few), and cubes
 //! in a drum of kinematic hull panels tumble as it turns without leaving it.
 
 use crate::common::{quat, step_until_asleep, v3, world, Rng};
@@ -67,8 +68,13 @@ fn rock(rng: &mut Rng, at: Vec3) -> Body {
 
 /// Rocks dropped between walls, the bodies of the pile and the walls.
 fn rock_pile(count: usize) -> verlet::Scene {
+    rock_pile_of_seed(count, 5)
+}
+
+/// The pile with its rocks drawn from seed `seed`.
+fn rock_pile_of_seed(count: usize, seed: u64) -> verlet::Scene {
     let mut scene = scenes::stack(0);
-    let mut rng = Rng(0x4011_0001_0000_0005);
+    let mut rng = Rng(0x4011_0001_0000_0000 + seed);
     for k in 0..count {
         let (x, z) = ((k % 4) as f32 * 0.9 - 1.35, (k / 4 % 4) as f32 * 0.9 - 1.35);
         scene.bodies.push(rock(&mut rng, Vec3::new(x, 0.6 + (k / 16) as f32 * 0.9, z)));
@@ -127,6 +133,28 @@ fn a_pile_of_hulls_falls_asleep() {
     let count = 80;
     let Some(mut w) = world(&rock_pile(count)) else { return };
     step_until_asleep(&mut w, count, 1800);
+}
+
+/// Whether a pile falls asleep whole is chaos: a rock may end wedged under
+/// sleepers or jittering in a cluster (docs/decisions/hulls.md), and a
+/// change to the solve moves which piles do. So the solve is judged on
+/// forty piles too. Two keep a rock awake after 20 s today; five or more
+/// would be unlikely by chance alone (about one in twenty, for a pile's
+/// odds of one in twenty), so a change that leaves them sleeps slower.
+#[test]
+fn forty_piles_of_hulls_fall_asleep_but_a_few() {
+    let count = 80;
+    let mut awake = Vec::new();
+    for seed in 1..=40 {
+        let Some(mut w) = world(&rock_pile_of_seed(count, seed)) else { return };
+        w.step(1200).unwrap();
+        let left = w.read_state().unwrap()[..count].iter().filter(|b| !b.asleep).count();
+        if left > 0 {
+            awake.push((seed, left));
+        }
+    }
+    eprintln!("hull piles of seeds 1 to 40 with rocks awake after 20 s (seed, rocks): {awake:?}");
+    assert!(awake.len() <= 4, "{} of 40 piles keep rocks awake after 20 s: {awake:?}", awake.len());
 }
 
 /// A drum of twelve kinematic hull panels about the z axis, turning at 2
