@@ -57,7 +57,7 @@ override LOOP_TRIPS: u32 = 0xffffffffu;
 // through the functions below: lavapipe loads a struct member by member, one
 // loop over the lanes each, and a vec4 in one loop (docs/lavapipe.md).
 
-// ManifoldPoints as stored: point q in at[2q] (local_a, pushed), at[2q + 1] (local_b).
+// ManifoldPoints as stored: point q in at[2q] (local_a, pushed), at[2q + 1] (local_b, last_push).
 struct PointsWords {
     at: array<vec4<f32>, 8>,
 }
@@ -284,12 +284,22 @@ fn set_pushed(at: vec2<u32>, q: u32, pushed: f32) {
     }
 }
 
+// Sets point q's push in the sweep just run (`last_push`) of the manifold at `at`.
+fn set_last_push(at: vec2<u32>, q: u32, push: f32) {
+    switch (at.x) {
+        case 0u: { points[at.y].at[2u * q + 1u].w = push; }
+        case 1u: { points_1[at.y].at[2u * q + 1u].w = push; }
+        case 2u: { points_2[at.y].at[2u * q + 1u].w = push; }
+        default: { points_3[at.y].at[2u * q + 1u].w = push; }
+    }
+}
+
 fn store_points(k: u32, p: ManifoldPoints) {
     let at = point_slot(k);
     var w: PointsWords;
     for (var q = 0u; q < MAX_POINTS; q = q + 1u) {
         w.at[2u * q] = vec4<f32>(p.at[q].local_a, p.at[q].pushed);
-        w.at[2u * q + 1u] = vec4<f32>(p.at[q].local_b, p.at[q]._pad0);
+        w.at[2u * q + 1u] = vec4<f32>(p.at[q].local_b, p.at[q].last_push);
     }
     switch (at.x) {
         case 0u: { points[at.y] = w; }

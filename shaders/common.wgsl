@@ -99,12 +99,13 @@ struct Pair {
 }
 
 // One contact point: the point on each body in its own frame (the ground's in world
-// coordinates), and its friction budget: the normal push summed this substep (m). 32 bytes.
+// coordinates), its friction budget: the normal push summed this substep (m), and
+// its normal push in the substep's last sweep (m; solve_contacts). 32 bytes.
 struct ContactPoint {
     local_a: vec3<f32>,
     pushed: f32,
     local_b: vec3<f32>,
-    _pad0: f32,
+    last_push: f32,
 }
 
 // A pair's contact manifold, found once a step: up to MAX_POINTS points sharing one

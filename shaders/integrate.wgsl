@@ -103,6 +103,10 @@ fn opaque(v: vec3<f32>) -> vec3<f32> {
 // dispatch, at 2-3 ms each (docs/decisions/integration.md).
 @compute @workgroup_size(WORKGROUP)
 fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
+    // the substep's sweeps start at weight 1 (solve.wgsl's sweep_weight)
+    if (gid.x == 0u) {
+        atomicStore(&status[STATUS_SWEEPS], 0u);
+    }
     let i = listed_body(gid.x);
     if (i >= params.body_count) {
         return;

@@ -14,7 +14,7 @@ use crate::limits::NO_FAULT;
 /// take (`Status::walk_dispatches`).
 pub const WALK_DISPATCHES: usize = 5;
 
-/// The status words, in buffer order (176 bytes). The host reads it back
+/// The status words, in buffer order (180 bytes). The host reads it back
 /// after each batch of steps (`World::fit_pools`), and on request.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -76,6 +76,10 @@ pub struct Status {
     pub walks_cut: u32,
     /// 1 once a contact list's sort may have been cut short alike (contact_lists); never cleared.
     pub lists_cut: u32,
+    /// The sweeps the substep has run so far (solve counts them,
+    /// restitution_contacts starts the next substep's at 0): which weight
+    /// solve_contacts gives its pushes (solve.wgsl's `sweep_weight`).
+    pub sweeps: u32,
 }
 
 /// The word index of a field of `Status`.
@@ -116,12 +120,13 @@ impl Status {
         walk_dispatches: [[0, 1, 1]; WALK_DISPATCHES],
         walks_cut: 0,
         lists_cut: 0,
+        sweeps: 0,
     };
 
     /// The WGSL name and the first word of every field, in order: the
     /// shared constants (`shaders::shared_constants`) by which WGSL indexes
     /// the status words.
-    pub const WORDS: [(&'static str, u32); 22] = [
+    pub const WORDS: [(&'static str, u32); 23] = [
         ("STATUS_PAIRS", word!(pairs)),
         ("STATUS_PAIRS_MAX", word!(pairs_max)),
         ("STATUS_FAULT", word!(fault)),
@@ -144,6 +149,7 @@ impl Status {
         ("STATUS_WALK_DISPATCHES", word!(walk_dispatches)),
         ("STATUS_WALKS_CUT", word!(walks_cut)),
         ("STATUS_LISTS_CUT", word!(lists_cut)),
+        ("STATUS_SWEEPS", word!(sweeps)),
     ];
 }
 

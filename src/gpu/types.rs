@@ -152,7 +152,9 @@ pub struct ContactPoint {
     pub pushed: f32,
     /// On body b, in its frame (the ground's: world coordinates).
     pub local_b: [f32; 3],
-    pub _pad0: f32,
+    /// Its normal push in the substep's last sweep (m), which the next
+    /// sweep's extrapolates (shaders/solve.wgsl's `sweep_weight`).
+    pub last_push: f32,
 }
 
 /// A pair's manifold's header (32 bytes): up to `MAX_POINTS` points sharing

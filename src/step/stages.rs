@@ -314,7 +314,7 @@ pub(crate) const TABLE: [StageInfo; 25] = {
         S {
             over: Over::Manifolds,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3],
+            reads: &[Params, Props, StateIn, Snaps, Manifolds, Status, PairMeta, Points, Points1, Points2, Points3, JointStart],
             writes: SNAP_WRITES,
             ..S::row(Stage::SolveContacts, "solve_contacts", SOLVE_PASS, Part::Solve)
         },
@@ -322,8 +322,8 @@ pub(crate) const TABLE: [StageInfo; 25] = {
             over: Over::Touching,
             poses: Poses::InPlace,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateOut, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds, Hulls],
-            writes: &[StateOut],
+            reads: &[Params, Props, StateOut, Sorted, Snaps, PairMeta, BodyPairs, JointStart, Snaps1, Manifolds, Hulls, Status],
+            writes: &[StateOut, Status],
             ..S::row(Stage::Solve, "solve", SOLVE_PASS, Part::Solve)
         },
         S {

@@ -78,7 +78,7 @@ fn shared_structs_match_member_by_member() {
     check_layout!(common, JointRef { local_self, partner, local_partner, body });
     check_layout!(common, Pair { a, b });
     check_layout!(common, CellBound { pos, bound, extent, body });
-    check_layout!(common, ContactPoint { local_a, pushed, local_b, _pad0 });
+    check_layout!(common, ContactPoint { local_a, pushed, local_b, last_push });
     check_layout!(common, ContactManifold { normal, count, a, b, clip_face, pair });
     check_layout!(common, ManifoldPoints { at });
     check_layout!(common, EndSnap { dx, count, dtheta, flags });
@@ -250,6 +250,7 @@ fn status_words_match_the_struct() {
         walk_dispatches => "STATUS_WALK_DISPATCHES",
         walks_cut => "STATUS_WALKS_CUT",
         lists_cut => "STATUS_LISTS_CUT",
+        sweeps => "STATUS_SWEEPS",
     );
     assert_eq!(Status::BYTES as usize, size_of::<Status>());
     // a dispatch's three words as wgpu reads them: x, y, z

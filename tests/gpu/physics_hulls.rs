@@ -136,13 +136,14 @@ fn a_pile_of_hulls_falls_asleep() {
 }
 
 /// Whether a pile falls asleep whole is chaos: a rock may end wedged under
-/// sleepers or jittering in a cluster (docs/decisions/hulls.md), about one
-/// pile in ten today, and a change to the solve moves which piles do, so
-/// one pile says little. Forty do: ten or more keeping a rock awake after
-/// 20 s would happen about once in two hundred by chance at today's odds.
-/// The check for a change to the solve; about 80 s on lavapipe.
+/// neighbours or jittering in a cluster (docs/decisions/hulls.md), about
+/// one pile in seven, and a change to the solve moves which piles do, so
+/// one pile says little. Forty do: thirteen or more keeping a rock awake
+/// after 20 s would happen about once in two hundred by chance at those
+/// odds (seeds 1 to 40 keep 7). The check for a change to the solve;
+/// about 90 s on lavapipe.
 #[test]
-#[ignore = "80 s on lavapipe: run by hand with --ignored --nocapture"]
+#[ignore = "90 s on lavapipe: run by hand with --ignored --nocapture"]
 fn forty_piles_of_hulls_fall_asleep_but_a_few() {
     let count = 80;
     let mut awake = Vec::new();
@@ -155,7 +156,7 @@ fn forty_piles_of_hulls_fall_asleep_but_a_few() {
         }
     }
     eprintln!("hull piles of seeds 1 to 40 with rocks awake after 20 s (seed, rocks): {awake:?}");
-    assert!(awake.len() <= 9, "{} of 40 piles keep rocks awake after 20 s: {awake:?}", awake.len());
+    assert!(awake.len() <= 12, "{} of 40 piles keep rocks awake after 20 s: {awake:?}", awake.len());
 }
 
 /// A drum of twelve kinematic hull panels about the z axis, turning at 2
