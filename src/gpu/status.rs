@@ -76,9 +76,9 @@ pub struct Status {
     pub walks_cut: u32,
     /// 1 once a contact list's sort may have been cut short alike (contact_lists); never cleared.
     pub lists_cut: u32,
-    /// The sweeps the substep has run so far (solve counts them,
-    /// restitution_contacts starts the next substep's at 0): which weight
-    /// solve_contacts gives its pushes (solve.wgsl's `sweep_weight`).
+    /// The sweeps the substep has run so far (integrate clears it, solve
+    /// counts them): which weight solve_contacts gives its pushes
+    /// (solve.wgsl's `sweep_weight`).
     pub sweeps: u32,
 }
 

@@ -153,7 +153,7 @@ pub struct ContactPoint {
     /// On body b, in its frame (the ground's: world coordinates).
     pub local_b: [f32; 3],
     /// Its normal push in the substep's last sweep (m), which the next
-    /// sweep's extrapolates (shaders/solve.wgsl's `sweep_weight`).
+    /// sweep's weighted push builds on (shaders/solve.wgsl's `sweep_weight`).
     pub last_push: f32,
 }
 
