@@ -62,7 +62,6 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     if (!ea.moves && !eb.moves) {
         for (var q = 0u; q < count; q = q + 1u) {
             set_pushed(at, q, 0.0);
-            set_last_push(at, q, 0.0);
         }
         return;
     }
@@ -100,7 +99,6 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     for (var q = 0u; q < count; q = q + 1u) {
         let pt = point_of(at, q);
         set_pushed(at, q, 0.0);
-        set_last_push(at, q, 0.0);
         let ra = ea.rot_m * end_point(ea, pt.local_a, n);
         let rb = eb.rot_m * end_point(eb, pt.local_b, -n);
         // touching?
