@@ -274,24 +274,25 @@ fn point_of(at: vec2<u32>, q: u32) -> ContactPoint {
     return ContactPoint(w[0].xyz, w[0].w, w[1].xyz, w[1].w);
 }
 
+// Sets the fourth word of the manifold's (at `at`) points' vec4 `word`
+// (PointsWords): a point's `pushed` or `last_push`.
+fn set_points_w(at: vec2<u32>, word: u32, value: f32) {
+    switch (at.x) {
+        case 0u: { points[at.y].at[word].w = value; }
+        case 1u: { points_1[at.y].at[word].w = value; }
+        case 2u: { points_2[at.y].at[word].w = value; }
+        default: { points_3[at.y].at[word].w = value; }
+    }
+}
+
 // Sets point q's friction budget (`pushed`) of the manifold at `at`.
 fn set_pushed(at: vec2<u32>, q: u32, pushed: f32) {
-    switch (at.x) {
-        case 0u: { points[at.y].at[2u * q].w = pushed; }
-        case 1u: { points_1[at.y].at[2u * q].w = pushed; }
-        case 2u: { points_2[at.y].at[2u * q].w = pushed; }
-        default: { points_3[at.y].at[2u * q].w = pushed; }
-    }
+    set_points_w(at, 2u * q, pushed);
 }
 
 // Sets point q's push in the sweep just run (`last_push`) of the manifold at `at`.
 fn set_last_push(at: vec2<u32>, q: u32, push: f32) {
-    switch (at.x) {
-        case 0u: { points[at.y].at[2u * q + 1u].w = push; }
-        case 1u: { points_1[at.y].at[2u * q + 1u].w = push; }
-        case 2u: { points_2[at.y].at[2u * q + 1u].w = push; }
-        default: { points_3[at.y].at[2u * q + 1u].w = push; }
-    }
+    set_points_w(at, 2u * q + 1u, push);
 }
 
 fn store_points(k: u32, p: ManifoldPoints) {
