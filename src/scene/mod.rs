@@ -47,7 +47,9 @@ pub const MAX_SUBSTEPS: u32 = 64;
 /// ([`Settings::substeps_for`]). The Jacobi sweeps carry a stack's support
 /// up one body a sweep, so a substep needs a few of its own: a 20-row
 /// pyramid placed imperfectly stands 10 s with three substeps of three
-/// (no box moves 4 cm) and falls with four of two or two of four.
+/// (no box moves 4 cm) and falls with four of two; two of four hold it too
+/// with the weighted sweeps, but open a loaded bridge's joints past 5 mm
+/// (docs/decisions/contacts.md, "The suggested 8 sweeps, split otherwise").
 pub const SWEEPS_PER_SUBSTEP: u32 = 3;
 
 /// Camera vertical field of view (radians) used when a `camera` block gives

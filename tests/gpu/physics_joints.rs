@@ -57,12 +57,12 @@ fn a_chain_of_21_links_swings_and_comes_to_rest_hanging() {
 }
 
 /// The settings a user's scene gets: the defaults (9 sweeps a step), or the
-/// interface's suggested `iterations` 8 (3 + 3 + 2 sweeps): joints must hold
-/// under both.
+/// interface's suggested `iterations` 8 in the substeps a scene that gives
+/// `iterations` alone gets (3 + 3 + 2 sweeps): joints must hold under both.
 const USER_SETTINGS: [(&str, u32); 2] = [("default", 9), ("suggested iterations 8", 8)];
 
 fn user_settings(mut scene: Scene, iterations: u32) -> Scene {
-    scene.settings = Settings { iterations, ..Settings::default() };
+    scene.settings = Settings { iterations, substeps: Settings::substeps_for(iterations), ..Settings::default() };
     scene
 }
 
@@ -198,7 +198,13 @@ fn a_chain_hung_by_both_ends_settles_into_a_catenary() {
     for (label, iterations) in USER_SETTINGS {
         let mut scene = scenes::hanging(links);
         let (linear_damping, angular_damping) = (scene.settings.linear_damping, scene.settings.angular_damping);
-        scene.settings = Settings { iterations, linear_damping, angular_damping, ..Settings::default() };
+        scene.settings = Settings {
+            iterations,
+            substeps: Settings::substeps_for(iterations),
+            linear_damping,
+            angular_damping,
+            ..Settings::default()
+        };
         let Some(mut w) = world(&scene) else { return };
         w.step(1200).unwrap(); // 20 s
         let state = w.read_state().unwrap();
