@@ -45,12 +45,13 @@ pub const MAX_SUBSTEPS: u32 = 64;
 
 /// The sweeps a substep takes when the solver picks the substeps
 /// ([`Settings::substeps_for`]). The Jacobi sweeps carry a stack's support
-/// up one body a sweep, so a substep needs a few of its own: a 20-row
-/// pyramid placed imperfectly stands 10 s with three substeps of three
-/// (no box moves 4 cm) and falls with four of two; two of four hold it too
-/// with the weighted sweeps, but open a loaded bridge's joints past 5 mm
-/// (docs/decisions/contacts.md, "The suggested 8 sweeps, split otherwise").
-pub const SWEEPS_PER_SUBSTEP: u32 = 3;
+/// up one body a sweep, and their Chebyshev weights grow within a
+/// substep, so a substep needs a few of its own: a 20-row pyramid placed
+/// imperfectly falls with four substeps of two, and Box3D's
+/// `large_pyramid` at the suggested 8 sweeps creeps less in two of four
+/// than in 3 + 3 + 2, for a substep's passes less (docs/decisions/contacts.md,
+/// "The suggested 8 sweeps, split otherwise").
+pub const SWEEPS_PER_SUBSTEP: u32 = 4;
 
 /// Camera vertical field of view (radians) used when a `camera` block gives
 /// no `fov_y`: 45 degrees, a natural-looking lens that neither distorts nor
@@ -130,8 +131,8 @@ pub struct Settings {
 impl Settings {
     /// The substeps a step of `iterations` sweeps takes when the scene does
     /// not say: `SWEEPS_PER_SUBSTEP` sweeps each, rounded up, within
-    /// 1..=`MAX_SUBSTEPS` (the contract's suggested 8 take three substeps:
-    /// 3, 3 and 2 sweeps).
+    /// 1..=`MAX_SUBSTEPS` (the contract's suggested 8 take two substeps of
+    /// 4 sweeps; the default 9 three of 3).
     pub fn substeps_for(iterations: u32) -> u32 {
         iterations.div_ceil(SWEEPS_PER_SUBSTEP).clamp(1, MAX_SUBSTEPS)
     }

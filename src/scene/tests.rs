@@ -48,8 +48,8 @@ fn error_of(text: &str) -> String {
 #[test]
 fn interface_example_loads() {
     let scene = Scene::from_json_str(INTERFACE_EXAMPLE).expect("example loads");
-    // the example spells out the contract's suggested 8 iterations
-    assert_eq!(scene.settings, Settings { iterations: 8, ..Settings::default() });
+    // the example spells out the contract's suggested 8 iterations, and no substeps
+    assert_eq!(scene.settings, Settings { iterations: 8, substeps: 2, ..Settings::default() });
     assert_eq!(scene.ground, Some(Ground { height: 0.0 }));
     assert_eq!(scene.bodies.len(), 3);
     assert_eq!(scene.joints.len(), 2);
@@ -358,7 +358,7 @@ fn to_json_round_trips() {
     assert!(text.contains("\"mass\""));
     assert!(!text.contains("density"));
     assert!(!text.contains("null"));
-    assert!(text.contains("\"substeps\": 3"));
+    assert!(text.contains("\"substeps\": 2"));
     assert!(!text.contains("camera"));
     // It is also plain JSON to any other reader.
     let value: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -407,10 +407,11 @@ fn iterations_are_the_sweeps_of_a_step_spread_over_its_substeps() {
 }
 
 #[test]
-fn a_scene_that_gives_iterations_alone_gets_three_sweeps_a_substep() {
+fn a_scene_that_gives_iterations_alone_gets_four_sweeps_a_substep() {
     let substeps = |json: &str| Scene::from_json_str(json).expect("loads").settings.substeps;
-    assert_eq!(substeps(r#"{"settings": {"iterations": 8}}"#), 3);
-    assert_eq!(substeps(r#"{"settings": {"iterations": 24}}"#), 8);
+    assert_eq!(substeps(r#"{"settings": {"iterations": 8}}"#), 2);
+    assert_eq!(substeps(r#"{"settings": {"iterations": 9}}"#), 3);
+    assert_eq!(substeps(r#"{"settings": {"iterations": 24}}"#), 6);
     assert_eq!(substeps(r#"{"settings": {"iterations": 1}}"#), 1);
     assert_eq!(substeps(r#"{"settings": {"iterations": 256}}"#), 64);
     // a scene's own substeps stand; none at all: the default

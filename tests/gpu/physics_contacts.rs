@@ -240,7 +240,7 @@ fn an_imperfect_pyramid_of_ten_rows_stands() {
 /// with the default settings and with the interface's suggested
 /// `iterations` 8 (split into substeps as a scene that gives it alone): its top drifts under 3 cm sideways, and at the defaults
 /// it never sinks 5 cm (sampled every step; at `iterations` 8 its top sinks
-/// 5.0 cm at most, the sweeps' lag in a column that tall). Before the lower
+/// 4.0 cm at most, the sweeps' lag in a column that tall). Before the lower
 /// body of a stacked pair counted less (SHOCK in solve.wgsl) it leaned 125 cm.
 #[test]
 fn an_imperfect_column_of_twenty_boxes_stands() {

@@ -58,7 +58,7 @@ fn a_chain_of_21_links_swings_and_comes_to_rest_hanging() {
 
 /// The settings a user's scene gets: the defaults (9 sweeps a step), or the
 /// interface's suggested `iterations` 8 in the substeps a scene that gives
-/// `iterations` alone gets (3 + 3 + 2 sweeps): joints must hold under both.
+/// `iterations` alone gets (4 + 4 sweeps): joints must hold under both.
 const USER_SETTINGS: [(&str, u32); 2] = [("default", 9), ("suggested iterations 8", 8)];
 
 fn user_settings(mut scene: Scene, iterations: u32) -> Scene {
