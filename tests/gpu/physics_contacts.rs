@@ -236,12 +236,13 @@ fn an_imperfect_pyramid_of_ten_rows_stands() {
     assert!(moved < 0.05, "a box moved {moved} m");
 }
 
-/// A column of 20 boxes placed imperfectly stands 10 s
-/// with the default settings and with the interface's suggested
-/// `iterations` 8 (split into substeps as a scene that gives it alone): its top drifts under 3 cm sideways, and at the defaults
-/// it never sinks 5 cm (sampled every step; at `iterations` 8 its top sinks
-/// 4.0 cm at most, the sweeps' lag in a column that tall). Before the lower
-/// body of a stacked pair counted less (SHOCK in solve.wgsl) it leaned 125 cm.
+/// A column of 20 boxes placed imperfectly stands 10 s with the default
+/// settings and with the interface's suggested `iterations` 8 (in the
+/// substeps a scene that gives it alone gets): its top drifts under 3 cm
+/// sideways, and at the defaults it never sinks 5 cm (sampled every step;
+/// at `iterations` 8 its top sinks 4.0 cm at most, the sweeps' lag in a
+/// column that tall). Before the lower body of a stacked pair counted less
+/// (SHOCK in solve.wgsl) it leaned 125 cm.
 #[test]
 fn an_imperfect_column_of_twenty_boxes_stands() {
     for (label, iterations) in [("default", 9), ("suggested iterations 8", 8)] {
