@@ -85,11 +85,11 @@ struct Params {
     substep: u32,            // which substep of the step this is (0 first)
     opaque_zero: u32,        // always 0; see `opaque` (integrate.wgsl)
     island_count: u32,       // joint islands (joint_rest)
-    joint_sweeps: u32,       // the most sweeps along a path per solve_joints pass
     path_first: u32,         // the paths of this solve_joints or solve_paths pass's colour:
     path_end: u32,           //   path_first..path_end (joint_lists)
     path_count: u32,         // the paths of every colour
     _pad1: u32,
+    _pad2: u32,
 }
 
 // A candidate pair (pairs.wgsl): body a owns it; b is a body or GROUND. 8 bytes.

@@ -400,6 +400,13 @@ fn out_of_fixed(r: u32, s: BodyState, p: BodyProps) -> vec3<f32> {
 // as it is (path_settled).
 const JOINT_SETTLED: f32 = 1e-5;
 
+// Gauss-Seidel sweeps along a path in a solve_joints pass (one pass after
+// each relaxation sweep), at most: a pass ends at a sweep that closes no
+// joint by more than JOINT_SETTLED. A ragdoll settles in a few; a bridge
+// pinned taut at both ends and loaded is the slowest case met, and its gaps
+// follow the sweeps a step makes, not its substeps (docs/step.md, "Joints").
+const JOINT_SWEEPS_PER_PASS: u32 = 32u;
+
 // Pass "solve_joints", after every solve, once per colour of joint paths
 // (joint_lists in src/world/records.rs), one invocation per path of an
 // island with a branch or a loop (of at most 128 joints; solve_paths takes
@@ -915,7 +922,7 @@ fn solve_joints(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the sweeps out and back as one loop counted by the path's length (a loop
     // bounded by a uniform alone is recompiled by lavapipe every dispatch)
     let n = end - first;
-    let sweeps = params.joint_sweeps;
+    let sweeps = JOINT_SWEEPS_PER_PASS;
     // Consecutive joints of a path share a body, so the two bodies of the last
     // joint closed stay in registers (held[k], its state kept[k], moved[k] if
     // not yet written back) rather than going to memory and back each close.

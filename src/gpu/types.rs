@@ -120,8 +120,6 @@ pub struct Params {
     /// Joint islands `joint_rest` keeps asleep or awake as one (see
     /// `joint_lists`).
     pub island_count: u32,
-    /// The most Gauss-Seidel sweeps along a path per `solve_joints` pass.
-    pub joint_sweeps: u32,
     /// The paths of this `solve_joints` or `solve_paths` pass's colour: `path_first..path_end`.
     pub path_first: u32,
     pub path_end: u32,
@@ -129,6 +127,7 @@ pub struct Params {
     /// follows their starts in `joint_start`).
     pub path_count: u32,
     pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// A candidate pair (8 bytes); see `Pair` in common.wgsl.

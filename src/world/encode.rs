@@ -17,14 +17,6 @@ use crate::Error;
 /// Params buffer.
 pub(super) const MAX_BATCH: usize = 64;
 
-/// Gauss-Seidel sweeps over the joints in a `solve_joints` pass, one pass
-/// after each relaxation sweep, at most: a path's pass ends at a sweep that
-/// closes no joint by more than `JOINT_SETTLED` (shaders/solve.wgsl). A
-/// ragdoll settles in a few; a bridge pinned taut at both ends and loaded is
-/// the slowest case met, and its gaps follow the sweeps a step makes, not
-/// its substeps (docs/step.md, "Joints").
-pub(crate) const JOINT_SWEEPS_PER_PASS: u32 = 32;
-
 impl World {
     /// The Params slots a substep takes: its own, then one per colour of
     /// the joint paths (`solve_joints` reads its colour's paths from it).
@@ -74,7 +66,6 @@ impl World {
                     substep: substep as u32,
                     opaque_zero: 0,
                     island_count: self.island_count,
-                    joint_sweeps: JOINT_SWEEPS_PER_PASS,
                     path_count: self.path_colours.last().copied().unwrap_or(0),
                     ..Params::default()
                 };

@@ -68,11 +68,11 @@ fn shared_structs_match_member_by_member() {
             substep,
             opaque_zero,
             island_count,
-            joint_sweeps,
             path_first,
             path_end,
             path_count,
-            _pad1
+            _pad1,
+            _pad2
         }
     );
     check_layout!(common, JointRef { local_self, partner, local_partner, body });
