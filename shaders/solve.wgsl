@@ -405,7 +405,7 @@ const JOINT_SETTLED: f32 = 1e-5;
 // joint by more than JOINT_SETTLED. A ragdoll settles in a few; a bridge
 // pinned taut at both ends and loaded is the slowest case met, and its gaps
 // follow the sweeps a step makes, not its substeps (docs/step.md, "Joints").
-const JOINT_SWEEPS_PER_PASS: u32 = 32u;
+const JOINT_SWEEPS_PER_PASS: u32 = 24u;
 
 // Pass "solve_joints", after every solve, once per colour of joint paths
 // (joint_lists in src/world/records.rs), one invocation per path of an
