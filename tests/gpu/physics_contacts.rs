@@ -1,7 +1,7 @@
 //! Many bodies colliding: piles settle, stacks and pyramids stand,
 //! fast bodies meet walls, friction holds on a ramp, runs repeat bit for bit.
 
-use crate::common::{quat, v3, world};
+use crate::common::{iterations_alone, quat, v3, world};
 use glam::{Quat, Vec3};
 use verlet::reference::collide::{collide, Placed, ShapeKind};
 use verlet::scenes::{self, box_body};
@@ -247,8 +247,7 @@ fn an_imperfect_pyramid_of_ten_rows_stands() {
 fn an_imperfect_column_of_twenty_boxes_stands() {
     for (label, iterations) in [("default", 9), ("suggested iterations 8", 8)] {
         let mut scene = imperfect(scenes::stack(20));
-        scene.settings =
-            verlet::Settings { iterations, substeps: verlet::Settings::substeps_for(iterations), ..verlet::Settings::default() };
+        scene.settings = iterations_alone(iterations);
         let Some(mut w) = world(&scene) else { return };
         let placed = Vec3::from(scene.bodies[19].position);
         let mut sank = 0.0f32;
@@ -605,8 +604,7 @@ fn a_light_box_under_a_heavy_one_stays_out_of_a_fixed_floor_and_wall() {
 fn thirty_boxes_placed_at_one_point_on_the_ground_part() {
     for (label, iterations) in [("default", 9), ("suggested iterations 8", 8)] {
         let mut scene = scenes::stack(0);
-        scene.settings =
-            verlet::Settings { iterations, substeps: verlet::Settings::substeps_for(iterations), ..verlet::Settings::default() };
+        scene.settings = iterations_alone(iterations);
         scene.bodies = (0..30).map(|_| box_body([0.5; 3], [0.0, 0.5, 0.0])).collect();
         let Some(mut w) = world(&scene) else { return };
         let mut fastest = 0.0f32;

@@ -1,7 +1,7 @@
 //! Ball joints: a chain that swings and comes to rest, a pendulum
 //! with the compound-pendulum period, a loaded bridge, ragdolls on a pile.
 
-use crate::common::{quat, v3, world};
+use crate::common::{iterations_alone, quat, v3, world};
 use glam::{Quat, Vec3};
 use verlet::scenes::{self, box_body};
 use verlet::world::joint_gaps;
@@ -62,7 +62,7 @@ fn a_chain_of_21_links_swings_and_comes_to_rest_hanging() {
 const USER_SETTINGS: [(&str, u32); 2] = [("default", 9), ("suggested iterations 8", 8)];
 
 fn user_settings(mut scene: Scene, iterations: u32) -> Scene {
-    scene.settings = Settings { iterations, substeps: Settings::substeps_for(iterations), ..Settings::default() };
+    scene.settings = iterations_alone(iterations);
     scene
 }
 
@@ -198,13 +198,7 @@ fn a_chain_hung_by_both_ends_settles_into_a_catenary() {
     for (label, iterations) in USER_SETTINGS {
         let mut scene = scenes::hanging(links);
         let (linear_damping, angular_damping) = (scene.settings.linear_damping, scene.settings.angular_damping);
-        scene.settings = Settings {
-            iterations,
-            substeps: Settings::substeps_for(iterations),
-            linear_damping,
-            angular_damping,
-            ..Settings::default()
-        };
+        scene.settings = Settings { linear_damping, angular_damping, ..iterations_alone(iterations) };
         let Some(mut w) = world(&scene) else { return };
         w.step(1200).unwrap(); // 20 s
         let state = w.read_state().unwrap();

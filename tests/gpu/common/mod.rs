@@ -39,6 +39,12 @@ pub fn world(scene: &Scene) -> Option<World> {
     Some(World::with_gpu(gpu, scene).expect("scene uploads"))
 }
 
+/// The settings a scene file that gives `iterations` alone gets: the
+/// substeps `Settings::substeps_for` picks, the rest the defaults.
+pub fn iterations_alone(iterations: u32) -> verlet::Settings {
+    verlet::Settings { iterations, substeps: verlet::Settings::substeps_for(iterations), ..verlet::Settings::default() }
+}
+
 /// Steps `w` 30 at a time until at least `asleep` of its bodies sleep,
 /// failing past `max_steps`; returns the steps taken.
 pub fn step_until_asleep(w: &mut World, asleep: usize, max_steps: u64) -> u64 {
