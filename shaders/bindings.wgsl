@@ -380,7 +380,7 @@ fn friction_split(i: u32, relaxation: f32) -> f32 {
 // Whether body i has a joint: its contacts then neither split their normal pushes
 // against ends that stay nor settle or cap their support (docs/decisions/joints.md).
 fn is_jointed(i: u32) -> bool {
-    return joint_start[i + 1u] > joint_start[i];
+    return HAS_JOINTS && joint_start[i + 1u] > joint_start[i];
 }
 
 // Whether the contacts may move body i: awake and not fixed (ContactEnd's `moves`).
@@ -406,9 +406,9 @@ fn contact_end(i: u32) -> ContactEnd {
     // load where no lane has one
     var radius = 0.0;
     var half_height = 0.0;
-    if (p.shape == SHAPE_SPHERE) {
+    if (HAS_ROUND && p.shape == SHAPE_SPHERE) {
         radius = props_of(i).half_extents.x;
-    } else if (p.shape == SHAPE_CAPSULE) {
+    } else if (HAS_ROUND && p.shape == SHAPE_CAPSULE) {
         let h = props_of(i).half_extents;
         radius = h.x;
         half_height = h.y;
@@ -481,7 +481,7 @@ fn poly_edge(h: Poly, e: u32) -> vec4<u32> {
 // world_extent, for every shape: a hull's from its corners, about the
 // centre `bound_sphere` gives.
 fn body_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
-    if (p.shape != SHAPE_HULL) {
+    if (!HAS_HULLS || p.shape != SHAPE_HULL) {
         return world_extent(s, p);
     }
     let h = poly_of(p);
@@ -499,7 +499,7 @@ fn body_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
 // for a hull kept out of the grid about its corners' box (a drum panel's
 // frame is the drum's axis; bounds about it held every body in the drum).
 fn bound_sphere(p: BodyProps) -> vec4<f32> {
-    if (p.shape == SHAPE_HULL && p.grid_class == LARGE_BODY) {
+    if (HAS_HULLS && p.shape == SHAPE_HULL && p.grid_class == LARGE_BODY) {
         return poly_sphere(poly_of(p));
     }
     return vec4<f32>(0.0, 0.0, 0.0, p.half_extents.w);
@@ -513,7 +513,7 @@ fn large_centre(j: u32) -> vec3<f32> {
 
 // reach_along, for every shape: a hull's farthest corner along dir.
 fn body_reach(p: BodyProps, rot: vec4<f32>, dir: vec3<f32>) -> f32 {
-    if (p.shape != SHAPE_HULL) {
+    if (!HAS_HULLS || p.shape != SHAPE_HULL) {
         return reach_along(p, rot, dir);
     }
     let h = poly_of(p);

@@ -5,6 +5,15 @@
 // with Rust (NONE, GROUND, WORKGROUP, the fault codes and limits, ...) are
 // written before this file from the Rust values (src/gpu/shaders.rs).
 
+// What the world holds that some code is for (src/step/pipelines.rs's
+// `Contents`): spheres or capsules, hulls, joints. A pass is compiled
+// without the code for what its world lacks: lavapipe runs every
+// instruction of a kernel whether or not any invocation takes its branch
+// (docs/lavapipe.md). Unset (the renderer, the tests' validation): all.
+override HAS_ROUND: bool = true;
+override HAS_HULLS: bool = true;
+override HAS_JOINTS: bool = true;
+
 // Pose of one body: what swaps between the two state buffers every pass. 64
 // bytes; quaternions are (x, y, z, w). The displacement x_n - x_(n-1) is kept
 // instead of the previous position, so the velocity disp / h is not the
@@ -211,10 +220,10 @@ struct JointRef {
 // Half extents of a body's world box: |R| h for a box, the radius for a
 // sphere, a capsule's segment's |R| h plus its radius.
 fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
-    if (p.shape == SHAPE_SPHERE) {
+    if (HAS_ROUND && p.shape == SHAPE_SPHERE) {
         return vec3<f32>(p.half_extents.x);
     }
-    if (p.shape == SHAPE_CAPSULE) {
+    if (HAS_ROUND && p.shape == SHAPE_CAPSULE) {
         return abs(quat_rotate(s.rot, vec3<f32>(0.0, p.half_extents.y, 0.0))) + p.half_extents.x;
     }
     let q = s.rot;
@@ -226,10 +235,10 @@ fn world_extent(s: BodyState, p: BodyProps) -> vec3<f32> {
 
 // How far a body's shape reaches from its centre along unit vector dir (m).
 fn reach_along(p: BodyProps, rot: vec4<f32>, dir: vec3<f32>) -> f32 {
-    if (p.shape == SHAPE_SPHERE) {
+    if (HAS_ROUND && p.shape == SHAPE_SPHERE) {
         return p.half_extents.x;
     }
-    if (p.shape == SHAPE_CAPSULE) {
+    if (HAS_ROUND && p.shape == SHAPE_CAPSULE) {
         return abs(quat_rotate(quat_conj(rot), dir).y) * p.half_extents.y + p.half_extents.x;
     }
     return dot(abs(quat_rotate(quat_conj(rot), dir)), p.half_extents.xyz);
@@ -380,7 +389,7 @@ struct ContactEnd {
 // stored material point away, and the ball sank through the ground); for a
 // capsule, that of the ball at the stored point's place along its segment.
 fn end_point(e: ContactEnd, stored: vec3<f32>, toward: vec3<f32>) -> vec3<f32> {
-    if (e.radius > 0.0) {
+    if (HAS_ROUND && e.radius > 0.0) {
         let surface = (toward * e.radius) * e.rot_m; // R^T (toward r)
         if (e.half_height > 0.0) {
             return surface + vec3<f32>(0.0, clamp(stored.y, -e.half_height, e.half_height), 0.0);

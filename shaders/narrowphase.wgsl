@@ -26,7 +26,7 @@ fn ground_manifold(i: u32, margin: f32) -> Manifold {
     let ground = params.ground_height;
     var m = empty_manifold();
     m.normal = vec3<f32>(0.0, -1.0, 0.0);
-    if (p.shape == SHAPE_SPHERE) {
+    if (HAS_ROUND && p.shape == SHAPE_SPHERE) {
         let lowest = s.pos - vec3<f32>(0.0, p.half_extents.x, 0.0);
         if (lowest.y - ground <= margin) {
             m.count = 1u;
@@ -35,7 +35,7 @@ fn ground_manifold(i: u32, margin: f32) -> Manifold {
         }
         return m;
     }
-    if (p.shape == SHAPE_CAPSULE) {
+    if (HAS_ROUND && p.shape == SHAPE_CAPSULE) {
         return ground_capsule(swept_of(shape_of(i)), ground, margin);
     }
     // heights of the eight corners above the ground
@@ -185,7 +185,7 @@ fn narrowphase(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     var m = empty_manifold();
     if (boxes) {
         axis = box_box_axis(a.centre, a.rot, a.half, b.centre, b.rot, b.half, margin);
-    } else {
+    } else if (HAS_ROUND) {
         m = collide_round(a, b, margin);
     }
     let touches = select(m.count > 0u, axis.kind != AXIS_APART, boxes);

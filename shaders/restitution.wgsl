@@ -152,7 +152,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     // a capsule's points lie along the axis it turns freely about: their
     // friction's pushes are averaged, as their turns are (`restituted`), and
     // as in the solve
-    if (ea.half_height > 0.0 || eb.half_height > 0.0) {
+    if (HAS_ROUND && (ea.half_height > 0.0 || eb.half_height > 0.0)) {
         j = j / f32(max(rubbing, 1u));
     }
     // Each point's bounce is computed as if it alone turned the approach
@@ -175,7 +175,7 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     // points (along its free axis) and a jointed body's (its joints pull back
     // against a stronger turn: ten capsule ragdolls kept a limb moving) keep
     // the mean over the points instead.
-    let capsule = ea.half_height > 0.0 || eb.half_height > 0.0;
+    let capsule = HAS_ROUND && (ea.half_height > 0.0 || eb.half_height > 0.0);
     let jointed = is_jointed(a) || (b != GROUND && is_jointed(b)); // a is never the ground
     let mean = capsule || jointed;
     let turns_a = select(turn_scale(k_a), 1.0, mean);

@@ -240,13 +240,13 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     // a capsule turns freely about its axis, and its points lie along it, so
     // their friction turns it as one point's does (the turns are averaged):
     // their pushes are averaged too, or a rolling capsule is held back
-    if (ea.half_height > 0.0 || eb.half_height > 0.0) {
+    if (HAS_ROUND && (ea.half_height > 0.0 || eb.half_height > 0.0)) {
         f_scale = min(f_scale, 1.0 / f32(max(rubbed, 1u)));
     }
     let j = normal_j * n_scale + friction_j * f_scale;
     // a capsule's points lie along the axis it turns freely about, so they
     // share one turn, their mean (docs/decisions/contacts.md)
-    let capsule = ea.half_height > 0.0 || eb.half_height > 0.0;
+    let capsule = HAS_ROUND && (ea.half_height > 0.0 || eb.half_height > 0.0);
     let mean = 1.0 / f32(max(points, 1u));
     let turns_a = select(turn_scale(k_a), mean, capsule);
     let turns_b = select(turn_scale(k_b), mean, capsule);
@@ -360,7 +360,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // jointed body: its joints, closed after the sweep, would pull it back.
     if (params.has_ground != 0u && !jointed) {
         var lowest = s.pos.y - world_extent(s, p).y;
-        if (p.shape == SHAPE_HULL) {
+        if (HAS_HULLS && p.shape == SHAPE_HULL) {
             lowest = s.pos.y - body_reach(p, s.rot, vec3<f32>(0.0, -1.0, 0.0));
         }
         let depth = params.ground_height - lowest;

@@ -32,6 +32,6 @@ mod pipelines;
 mod stages;
 
 pub use buffers::Buffer;
-pub(crate) use pipelines::{storage_buffers, StepPipelines};
+pub(crate) use pipelines::{storage_buffers, Contents, StepPipelines};
 pub(crate) use stages::{Over, Poses, Runs};
 pub use stages::{Part, Stage};

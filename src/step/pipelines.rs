@@ -2,6 +2,32 @@
 
 use super::{Buffer, Stage};
 use crate::gpu::{types::Params, Gpu};
+use crate::scene::{Scene, Shape};
+
+/// What a world holds that some of the passes' code is for (HAS_ROUND,
+/// HAS_HULLS and HAS_JOINTS in common.wgsl). The passes are compiled
+/// without the code for what the world lacks: lavapipe runs every
+/// instruction of a kernel, whatever branch its invocations take, so a pile
+/// of boxes paid for the spheres', capsules' and hulls' code in every pass
+/// (docs/lavapipe.md). The results are the same bits either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Contents {
+    /// Spheres or capsules.
+    pub round: bool,
+    pub hulls: bool,
+    pub joints: bool,
+}
+
+impl Contents {
+    pub(crate) fn of(scene: &Scene) -> Contents {
+        let shapes = || scene.bodies.iter().map(|b| &b.shape);
+        Contents {
+            round: shapes().any(|s| matches!(s, Shape::Sphere { .. } | Shape::Capsule { .. })),
+            hulls: shapes().any(|s| matches!(s, Shape::Hull(_))),
+            joints: !scene.joints.is_empty(),
+        }
+    }
+}
 
 /// The most storage buffers any stage binds; the device must allow this
 /// many per shader stage.
@@ -18,6 +44,8 @@ pub(crate) struct StepPipelines {
     pipelines: Vec<wgpu::ComputePipeline>,
     /// Compiled for a manifold pool in parts (POOL_SPLIT in bindings.wgsl).
     pub pool_split: bool,
+    /// Compiled for a world holding these.
+    contents: Contents,
 }
 
 fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
@@ -38,12 +66,17 @@ fn entry(buffer: Buffer) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry { binding: buffer.binding(), visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
 }
 
-/// One pass for its layout (the override constants: POOL_SPLIT,
-/// DISPATCH_ROW from the device's limits, the stage's own from its row,
-/// LOOP_TRIPS where the driver limits loops), compiled once per device.
-fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: bool) -> wgpu::ComputePipeline {
+/// One pass for its layout (the override constants: POOL_SPLIT, what the
+/// world holds, DISPATCH_ROW from the device's limits, the stage's own from
+/// its row, LOOP_TRIPS where the driver limits loops), compiled once per
+/// device for each set of them.
+fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: bool, contents: Contents) -> wgpu::ComputePipeline {
+    let flag = |on: bool| f64::from(u8::from(on));
     let mut constants = vec![
-        ("POOL_SPLIT", f64::from(u8::from(pool_split))),
+        ("POOL_SPLIT", flag(pool_split)),
+        ("HAS_ROUND", flag(contents.round)),
+        ("HAS_HULLS", flag(contents.hulls)),
+        ("HAS_JOINTS", flag(contents.joints)),
         ("DISPATCH_ROW", f64::from(gpu.limits.max_compute_workgroups_per_dimension)),
     ];
     constants.extend_from_slice(stage.info().constants);
@@ -56,9 +89,10 @@ fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: 
 
 impl StepPipelines {
     /// The step's passes, for a manifold pool in parts where `pool_split`
-    /// (see `World::make_pools`): compiled on the device's first world, and
-    /// found again (`Gpu::compute_pipelines`) by every other and every edit.
-    pub(crate) fn new(gpu: &Gpu, pool_split: bool) -> StepPipelines {
+    /// (see `World::make_pools`) and a world holding `contents`: compiled on
+    /// the device's first such world, and found again
+    /// (`Gpu::compute_pipelines`) by every other and every edit.
+    pub(crate) fn new(gpu: &Gpu, pool_split: bool, contents: Contents) -> StepPipelines {
         let layouts: Vec<wgpu::BindGroupLayout> = Stage::ALL
             .iter()
             .map(|stage| {
@@ -66,8 +100,21 @@ impl StepPipelines {
                 gpu.bind_group_layout(stage.name(), &entries)
             })
             .collect();
-        let pipelines = Stage::ALL.iter().map(|&stage| compile(gpu, stage, &layouts[stage as usize], pool_split)).collect();
-        StepPipelines { layouts, pipelines, pool_split }
+        let pipelines =
+            Stage::ALL.iter().map(|&stage| compile(gpu, stage, &layouts[stage as usize], pool_split, contents)).collect();
+        StepPipelines { layouts, pipelines, pool_split, contents }
+    }
+
+    /// The passes for a world that now holds `contents` (an edit added or
+    /// removed bodies or joints), where that differs: the layouts stay, so
+    /// the bind groups do.
+    pub(crate) fn hold(&mut self, gpu: &Gpu, contents: Contents) {
+        if contents != self.contents {
+            for stage in Stage::ALL {
+                self.pipelines[stage as usize] = compile(gpu, stage, &self.layouts[stage as usize], self.pool_split, contents);
+            }
+            self.contents = contents;
+        }
     }
 
     /// The passes that touch the manifold pool's parts, compiled for a pool
@@ -76,7 +123,7 @@ impl StepPipelines {
         for stage in Stage::ALL {
             let buffers = stage.buffers();
             if buffers.contains(&Buffer::Points) || buffers.contains(&Buffer::Snaps1) {
-                self.pipelines[stage as usize] = compile(gpu, stage, &self.layouts[stage as usize], true);
+                self.pipelines[stage as usize] = compile(gpu, stage, &self.layouts[stage as usize], true, self.contents);
             }
         }
         self.pool_split = true;

@@ -22,6 +22,7 @@ use crate::gpu::types::{BodyProps, BodyState};
 use crate::limits::NO_FAULT;
 use crate::load_error::LoadError;
 use crate::scene::{Body, Joint, Scene};
+use crate::step::Contents;
 use crate::Error;
 
 impl World {
@@ -122,6 +123,7 @@ impl World {
         // no body has woken another yet (`PairMeta::woken`), and no contacts
         encoder.clear_buffer(&data.pair_meta, 0, None);
         self.gpu.submit(encoder.finish());
+        self.pipelines.hold(&self.gpu, Contents::of(&scene));
         data.bind_groups = Some(data.step_bind_groups(&self.gpu.device, &self.pipelines));
         self.gpu.check()?;
 

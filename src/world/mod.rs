@@ -13,7 +13,7 @@ use std::sync::Arc;
 use crate::gpu::status::Status;
 use crate::gpu::{types::*, Gpu};
 use crate::scene::{Scene, Settings};
-use crate::step::StepPipelines;
+use crate::step::{Contents, StepPipelines};
 use crate::Error;
 
 mod buffers;
@@ -126,7 +126,7 @@ impl World {
         let mut data =
             WorldData::new(&gpu, n, &props, &states, &Statics { large: &large, hulls: &hulls, joints: &joints }, settings.substeps);
         let (_, manifold_capacity) = pair_capacities(&gpu, n.max(1) as u64);
-        let pipelines = StepPipelines::new(&gpu, capacity::pool_in_parts(&gpu, manifold_capacity));
+        let pipelines = StepPipelines::new(&gpu, capacity::pool_in_parts(&gpu, manifold_capacity), Contents::of(scene));
         data.bind_groups = Some(data.step_bind_groups(&gpu.device, &pipelines));
         gpu.check()?;
         let substep_dt = settings.dt / settings.substeps as f32;

@@ -2,7 +2,9 @@
 
 use crate::common::{v3, world};
 use verlet::scenes::{self, box_body};
-use verlet::{Error, Joint};
+use verlet::world::joint_gaps;
+use verlet::scene::HullShape;
+use verlet::{Body, Error, Joint, Shape};
 
 #[test]
 fn bodies_spawned_into_a_running_pile_settle_with_the_rest() {
@@ -86,4 +88,48 @@ fn bad_edits_are_refused_and_change_nothing() {
     assert_eq!(w.body_count(), 3);
     let after = w.read_raw().unwrap();
     assert!(bytemuck::cast_slice::<_, u8>(&before) == bytemuck::cast_slice::<_, u8>(&after));
+}
+
+/// The passes are compiled without the code for shapes and joints a world
+/// does not hold (`Contents` in src/step/pipelines.rs); a world of boxes
+/// that is given a sphere, a capsule, a hull and a pendulum gets it back.
+/// After 3 s each rests on the ground where its shape says, the sphere
+/// set rolling has rolled, and the pendulum's joint is closed.
+#[test]
+fn shapes_and_joints_added_to_a_world_of_boxes_are_simulated() {
+    let scene = scenes::cubes(20, 1);
+    let Some(mut w) = world(&scene) else { return };
+    w.step(30).unwrap();
+    let corners = [-1.0f32, 1.0].iter().flat_map(|&x| [-1.0f32, 1.0].iter().flat_map(move |&y| [[x, y, -1.0], [x, y, 1.0]])).collect();
+    let mut ball = Body::new(Shape::Sphere { radius: 0.4 }, [40.0, 2.0, 10.0]);
+    ball.linear_velocity = [3.0, 0.0, 0.0];
+    let mut lying = Body::new(Shape::Capsule { radius: 0.3, half_height: 0.5 }, [44.0, 2.0, 0.0]);
+    lying.orientation = [0.0, 0.0, std::f32::consts::FRAC_1_SQRT_2, std::f32::consts::FRAC_1_SQRT_2];
+    let added = [
+        ball,
+        lying,
+        Body::new(Shape::Hull(HullShape::new(corners).unwrap()), [48.0, 3.0, 0.0]),
+        box_body([0.5, 0.1, 0.1], [52.5, 5.0, 0.0]),
+    ];
+    let pin = Joint { bodies: [23, -1], anchors: [[-0.5, 0.0, 0.0], [52.0, 5.0, 0.0]] };
+    let range = w.add_bodies(&added, std::slice::from_ref(&pin)).unwrap();
+    assert_eq!(range, 20..24);
+    w.step(180).unwrap();
+    let state = w.read_state().unwrap();
+    let heights: Vec<f32> = state[20..23].iter().map(|b| b.position[1]).collect();
+    let rolled = state[20].position[0] - 40.0;
+    let mut now = scene.clone();
+    now.bodies.extend(added);
+    now.joints = vec![pin];
+    let gap = joint_gaps(&now, &w.read_raw().unwrap())[0];
+    eprintln!(
+        "added to a world of boxes: sphere, capsule and hull at heights {heights:?} m, the sphere rolled {rolled} m, \
+         the pendulum's joint {gap} m open"
+    );
+    assert!((heights[0] - 0.4).abs() < 0.02, "the sphere rests at {} m", heights[0]);
+    // compiled without the spheres' code, it slid as a box (2.2 m)
+    assert!(rolled > 4.0, "the sphere, set off at 3 m/s, rolled {rolled} m");
+    assert!((heights[1] - 0.3).abs() < 0.02, "the capsule rests at {} m", heights[1]);
+    assert!((heights[2] - 1.0).abs() < 0.02, "the hull rests at {} m", heights[2]);
+    assert!(gap < 1e-3, "the pendulum's joint opened {gap} m");
 }
