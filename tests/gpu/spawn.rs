@@ -1,9 +1,9 @@
 //! Adding and removing bodies while a world runs.
 
 use crate::common::{v3, world};
+use verlet::scene::HullShape;
 use verlet::scenes::{self, box_body};
 use verlet::world::joint_gaps;
-use verlet::scene::HullShape;
 use verlet::{Body, Error, Joint, Shape};
 
 #[test]
@@ -100,7 +100,8 @@ fn shapes_and_joints_added_to_a_world_of_boxes_are_simulated() {
     let scene = scenes::cubes(20, 1);
     let Some(mut w) = world(&scene) else { return };
     w.step(30).unwrap();
-    let corners = [-1.0f32, 1.0].iter().flat_map(|&x| [-1.0f32, 1.0].iter().flat_map(move |&y| [[x, y, -1.0], [x, y, 1.0]])).collect();
+    let corners =
+        [-1.0f32, 1.0].iter().flat_map(|&x| [-1.0f32, 1.0].iter().flat_map(move |&y| [[x, y, -1.0], [x, y, 1.0]])).collect();
     let mut ball = Body::new(Shape::Sphere { radius: 0.4 }, [40.0, 2.0, 10.0]);
     ball.linear_velocity = [3.0, 0.0, 0.0];
     let mut lying = Body::new(Shape::Capsule { radius: 0.3, half_height: 0.5 }, [44.0, 2.0, 0.0]);
