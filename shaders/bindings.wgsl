@@ -345,7 +345,7 @@ fn set_snap(r: u32, s: EndSnap) {
 // wakes when a body touching it moves faster than WAKE_SPEED or lies
 // WAKE_DEPTH inside it, and on any input or edit.
 fn asleep(s: BodyState) -> bool {
-    return params.sleep_after > 0.0 && s.rest_time >= params.sleep_after;
+    return SLEEPING && params.sleep_after > 0.0 && s.rest_time >= params.sleep_after;
 }
 
 const SLEEP_SPEED: f32 = 0.05; // m/s

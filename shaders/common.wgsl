@@ -5,14 +5,15 @@
 // with Rust (NONE, GROUND, WORKGROUP, the fault codes and limits, ...) are
 // written before this file from the Rust values (src/gpu/shaders.rs).
 
-// What the world holds that some code is for (src/step/pipelines.rs's
-// `Contents`): spheres or capsules, hulls, joints. A pass is compiled
-// without the code for what its world lacks: lavapipe runs every
+// What the world holds or does that some code is for (src/step/pipelines.rs's
+// `Contents`): spheres or capsules, hulls, joints, sleeping. A pass is
+// compiled without the code for what its world lacks: lavapipe runs every
 // instruction of a kernel whether or not any invocation takes its branch
 // (docs/lavapipe.md). Unset (the renderer, the tests' validation): all.
 override HAS_ROUND: bool = true;
 override HAS_HULLS: bool = true;
 override HAS_JOINTS: bool = true;
+override SLEEPING: bool = true;
 
 // Pose of one body: what swaps between the two state buffers every pass. 64
 // bytes; quaternions are (x, y, z, w). The displacement x_n - x_(n-1) is kept

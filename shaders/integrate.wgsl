@@ -166,16 +166,16 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (!wake) {
             rest = s.rest_time;
         }
-    } else if (select(false, resting, params.sleep_after > 0.0)) {
+    } else if (SLEEPING && select(false, resting, params.sleep_after > 0.0)) {
         // a jointed body falls asleep only where its island's rest time was
         // just shared (joint_rest, in a step's first substep alone): in the
         // later substeps its count stops short of sleep_after
         let short = bitcast<f32>(bitcast<u32>(params.sleep_after) - 1u);
         rest = select(s.rest_time + dt, min(s.rest_time + dt, short), jointed && params.substep != 0u);
-    } else if (select(false, jittering, params.sleep_after > 0.0)) {
+    } else if (SLEEPING && select(false, jittering, params.sleep_after > 0.0)) {
         rest = max(s.rest_time - dt, 0.0);
     }
-    if (rest >= params.sleep_after && rest > 0.0) {
+    if (SLEEPING && rest >= params.sleep_after && rest > 0.0) {
         // asleep: held still where it is (resting on what pressed it)
         set_state(i, BodyState(s.pos, rest, vec3<f32>(0.0), (s.pos_low & ~WAKES) | HELD | wakes, s.rot, s.rot));
         vel0[i] = Velocity(vec4<f32>(0.0), vec4<f32>(0.0));

@@ -4,18 +4,21 @@ use super::{Buffer, Stage};
 use crate::gpu::{types::Params, Gpu};
 use crate::scene::{Scene, Shape};
 
-/// What a world holds that some of the passes' code is for (HAS_ROUND,
-/// HAS_HULLS and HAS_JOINTS in common.wgsl). The passes are compiled
-/// without the code for what the world lacks: lavapipe runs every
-/// instruction of a kernel, whatever branch its invocations take, so a pile
-/// of boxes paid for the spheres', capsules' and hulls' code in every pass
-/// (docs/lavapipe.md). The results are the same bits either way.
+/// What a world holds or does that some of the passes' code is for
+/// (HAS_ROUND, HAS_HULLS, HAS_JOINTS and SLEEPING in common.wgsl). The
+/// passes are compiled without the code for what the world lacks: lavapipe
+/// runs every instruction of a kernel, whatever branch its invocations
+/// take, so a pile of boxes paid for the spheres', capsules' and hulls'
+/// code in every pass (docs/lavapipe.md). The results are the same bits
+/// either way.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Contents {
     /// Spheres or capsules.
     pub round: bool,
     pub hulls: bool,
     pub joints: bool,
+    /// `settings.sleeping`.
+    pub sleeping: bool,
 }
 
 impl Contents {
@@ -25,6 +28,7 @@ impl Contents {
             round: shapes().any(|s| matches!(s, Shape::Sphere { .. } | Shape::Capsule { .. })),
             hulls: shapes().any(|s| matches!(s, Shape::Hull(_))),
             joints: !scene.joints.is_empty(),
+            sleeping: scene.settings.sleeping,
         }
     }
 }
@@ -77,6 +81,7 @@ fn compile(gpu: &Gpu, stage: Stage, layout: &wgpu::BindGroupLayout, pool_split: 
         ("HAS_ROUND", flag(contents.round)),
         ("HAS_HULLS", flag(contents.hulls)),
         ("HAS_JOINTS", flag(contents.joints)),
+        ("SLEEPING", flag(contents.sleeping)),
         ("DISPATCH_ROW", f64::from(gpu.limits.max_compute_workgroups_per_dimension)),
     ];
     constants.extend_from_slice(stage.info().constants);
