@@ -358,14 +358,15 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     // on light ones pushed the light ones through it. A body left deeper than
     // GROUND_DEPTH in the ground is lifted to it, both poses alike. Not a
     // jointed body: its joints, closed after the sweep, would pull it back.
-    if (params.has_ground != 0u && !jointed) {
-        var lowest = s.pos.y - world_extent(s, p).y;
-        if (HAS_HULLS && p.shape == SHAPE_HULL) {
-            lowest = s.pos.y - body_reach(p, s.rot, vec3<f32>(0.0, -1.0, 0.0));
-        }
-        let depth = params.ground_height - lowest;
-        s.pos.y = s.pos.y + max(depth - GROUND_DEPTH, 0.0);
+    // A select, not a branch: where no joint is compiled in (HAS_JOINTS) the
+    // condition is the uniform's alone, and lavapipe compiled such a pass
+    // again at every dispatch (docs/lavapipe.md).
+    var lowest = s.pos.y - world_extent(s, p).y;
+    if (HAS_HULLS && p.shape == SHAPE_HULL) {
+        lowest = s.pos.y - body_reach(p, s.rot, vec3<f32>(0.0, -1.0, 0.0));
     }
+    let depth = params.ground_height - lowest;
+    s.pos.y = select(s.pos.y, s.pos.y + max(depth - GROUND_DEPTH, 0.0), params.has_ground != 0u && !jointed);
     // The same for fixed bodies: walls and floors made of boxes stay too.
     if (fixed_partners && !jointed) {
         for (var e = first; e < end; e = e + 1u) {
@@ -894,7 +895,7 @@ fn colour_path(gid: vec3<u32>, direct: bool) -> vec2<u32> {
     }
     let first = joint_start[at];
     // an asleep island is left as it is (joint_rest shares its rest time)
-    if (params.sleep_after > 0.0 && out_state(joint_refs[first].body).rest_time >= params.sleep_after) {
+    if (asleep(out_state(joint_refs[first].body))) {
         return vec2<u32>(NONE);
     }
     return vec2<u32>(first, joint_start[at + 1u]);
