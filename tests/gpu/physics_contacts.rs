@@ -512,9 +512,13 @@ fn heavy_on_light_pile() -> Scene {
 }
 
 /// The deepest any of the first `cubes` unit cubes of `scene` goes below
-/// y = 0 (m), sampled every 10 steps for 10 s.
-fn deepest_below_zero(scene: &Scene, cubes: usize) -> Option<f32> {
+/// y = 0 (m), sampled every 10 steps for 10 s; `fix`: a body an input makes
+/// fixed before the first step.
+fn deepest_below_zero(scene: &Scene, cubes: usize, fix: Option<usize>) -> Option<f32> {
     let mut w = world(scene)?;
+    if let Some(body) = fix {
+        w.set_fixed(body, true).unwrap();
+    }
     let mut deepest = 0.0f32;
     for _ in 0..60 {
         w.step(10).unwrap();
@@ -534,7 +538,7 @@ fn deepest_below_zero(scene: &Scene, cubes: usize) -> Option<f32> {
 #[test]
 fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_the_ground() {
     let scene = heavy_on_light_pile();
-    let Some(deepest) = deepest_below_zero(&scene, scene.bodies.len()) else { return };
+    let Some(deepest) = deepest_below_zero(&scene, scene.bodies.len(), None) else { return };
     eprintln!("heavy on light: deepest a cube went into the ground {deepest} m");
     assert!(deepest < 0.011, "a cube went {deepest} m into the ground");
 }
@@ -551,9 +555,22 @@ fn heavy_cubes_piled_on_light_ones_do_not_push_them_through_a_fixed_floor() {
     let mut floor = box_body([40.0, 1.0, 40.0], [0.0, -1.0, 0.0]);
     floor.fixed = true;
     scene.bodies.push(floor);
-    let Some(deepest) = deepest_below_zero(&scene, cubes) else { return };
+    let Some(deepest) = deepest_below_zero(&scene, cubes, None) else { return };
     eprintln!("heavy on light on a fixed floor: deepest a cube went into it {deepest} m");
     assert!(deepest < 0.011, "a cube went {deepest} m into the fixed floor");
+}
+
+/// The same, the floor made fixed by an input before the first step (a
+/// scene of dynamic bodies alone).
+#[test]
+fn a_floor_an_input_fixes_holds_heavy_cubes_piled_on_light_ones() {
+    let mut scene = heavy_on_light_pile();
+    let cubes = scene.bodies.len();
+    scene.ground = None;
+    scene.bodies.push(box_body([40.0, 1.0, 40.0], [0.0, -1.0, 0.0]));
+    let Some(deepest) = deepest_below_zero(&scene, cubes, Some(cubes)) else { return };
+    eprintln!("heavy on light on a floor an input fixed: deepest a cube went into it {deepest} m");
+    assert!(deepest < 0.011, "a cube went {deepest} m into the floor an input fixed");
 }
 
 /// A unit box under one 100 times heavier, on a fixed box for a floor and,
