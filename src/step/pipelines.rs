@@ -134,6 +134,11 @@ impl StepPipelines {
         self.pool_split = true;
     }
 
+    /// What the passes are compiled for (what the world holds).
+    pub(crate) fn contents(&self) -> Contents {
+        self.contents
+    }
+
     pub(crate) fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {
         &self.pipelines[stage as usize]
     }

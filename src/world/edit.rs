@@ -135,7 +135,6 @@ impl World {
         self.large_count = large.len() as u32;
         self.body_count = n as u32;
         self.island_count = joints.islands;
-        self.has_hulls = !hulls.is_empty();
         self.island_joints = joints.island_joints(n);
         self.path_kinds = joints.path_kinds();
         self.path_colours = joints.colours;

@@ -182,7 +182,8 @@ impl World {
         let many_blocks = |len: u32| len > SCAN_SPAN;
         let once = |s: &&Stage| match s.info().runs {
             Runs::EachStep => true,
-            Runs::EachStepWithHulls => self.has_hulls,
+            // where a body is a hull
+            Runs::EachStepWithHulls => self.pipelines.contents().hulls,
             Runs::EachStepOverManyBuckets => many_blocks(self.grid.hash_size),
             Runs::EachStepOverManyBodies => many_blocks(self.body_count),
             Runs::InSubsteps => false,

@@ -65,8 +65,6 @@ pub struct World {
     /// Joint islands (`joint_rest` and `solve_joints` run only when there
     /// are any).
     island_count: u32,
-    /// Whether a body is a hull: the step then runs `narrowphase_hull`.
-    has_hulls: bool,
     /// The joints of the islands' lists: `joint_rest` runs one invocation
     /// for each.
     island_joints: u32,
@@ -140,7 +138,6 @@ impl World {
             large_count: large.len() as u32,
             body_count: n as u32,
             island_count: joints.islands,
-            has_hulls: !hulls.is_empty(),
             island_joints: joints.island_joints(n),
             path_colours: joints.colours.clone(),
             path_kinds: joints.path_kinds(),
