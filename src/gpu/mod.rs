@@ -9,6 +9,7 @@
 pub mod shaders;
 #[doc(hidden)]
 pub mod status;
+mod subnormals;
 #[doc(hidden)]
 pub mod types;
 
@@ -255,6 +256,9 @@ impl Gpu {
             ..wgpu::Limits::default()
         };
         let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        // a software adapter's threads start as its device opens, with this
+        // thread's floating-point controls (subnormals.rs)
+        let flush = (info.device_type == wgpu::DeviceType::Cpu).then(subnormals::FlushToZero::begin);
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("verlet"),
@@ -264,6 +268,7 @@ impl Gpu {
             })
             .await
             .map_err(|e| GpuError::Device(e.to_string()))?;
+        drop(flush);
         let errors = std::sync::Arc::new(std::sync::Mutex::new(None));
         let sink = errors.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {

@@ -33,4 +33,5 @@ mod sleeping;
 mod snapshot;
 mod spawn;
 mod stress;
+mod subnormals;
 mod user_input;
