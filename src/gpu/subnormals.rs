@@ -5,7 +5,7 @@
 //! it. Left as a process has them, every operation on a subnormal float (a
 //! quaternion's part of 1e-20 squared, a push a path's elimination shrank to
 //! nothing) takes the CPU's slow path, a hundred cycles or more: a joint
-//! grid's direct solve ran 2.6 times slower for it. GPUs flush such values
+//! grid's direct solve ran 2.8 times slower for it. GPUs flush such values
 //! to zero, and WGSL allows it; so `Gpu::new` opens a software adapter's
 //! device with flushing on (x86's FTZ and DAZ), and gives the calling thread
 //! back its own controls once the device is open.

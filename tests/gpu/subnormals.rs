@@ -1,6 +1,6 @@
 //! A software adapter's kernels see subnormal floats flushed to zero, as
 //! GPUs do (`src/gpu/subnormals.rs`: lavapipe's slow path for them made a
-//! joint grid's solve 2.6 times slower), and the thread that opened the
+//! joint grid's solve 2.8 times slower), and the thread that opened the
 //! device keeps its own floating-point controls.
 
 use std::hint::black_box;
