@@ -203,6 +203,9 @@ impl Gpu {
     /// Opens the adapter that wgpu's environment variables select
     /// (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`, `WGPU_POWER_PREF`), else the
     /// default one; on a machine with no GPU that is a software adapter.
+    /// A software adapter's device is opened with subnormal floats flushed
+    /// to zero, as GPUs have them, for the threads it starts; the calling
+    /// thread keeps its own floating-point controls.
     pub fn new() -> Result<Gpu, GpuError> {
         pollster::block_on(Self::new_async())
     }
