@@ -98,7 +98,7 @@ struct Params {
     path_first: u32,         // the paths of this solve_joints or solve_paths pass's colour:
     path_end: u32,           //   path_first..path_end (joint_lists)
     path_count: u32,         // the paths of every colour
-    _pad1: u32,
+    second: u32,             // 1 in a substep's second solve_paths of each colour
     _pad2: u32,
 }
 

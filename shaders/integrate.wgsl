@@ -106,6 +106,7 @@ fn integrate(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the substep's sweeps start at weight 1 (solve.wgsl's sweep_weight)
     if (gid.x == 0u) {
         atomicStore(&status[STATUS_SWEEPS], 0u);
+        atomicStore(&status[STATUS_PATHS_AGAIN], 0u);
     }
     let i = listed_body(gid.x);
     if (i >= params.body_count) {

@@ -318,6 +318,11 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         fixed_partners = fixed_partners || (snap.count & SNAP_FIXED_PARTNER) != 0u;
         flags = flags | snap.flags;
     }
+    // a jointed body the contacts move: the substep's second solve of the
+    // paths has work (solve_paths)
+    if (jointed && touching > 0u) {
+        atomicStore(&status[STATUS_PATHS_AGAIN], 1u);
+    }
     // summed turns overshoot, so each partner's turn is scaled back to one
     // (turn_scale) and the partners' turns are averaged (translations are
     // scaled per partner)
@@ -757,11 +762,12 @@ fn shared_end(a: u32, b: u32, before: vec2<u32>) -> vec2<u32> {
 // closes, one pass reaches; the colours' turns still carry corrections
 // between paths. Such a chain is held at one point at most (joint_lists),
 // so its system is never singular.
-fn solve_path(first: u32, end: u32, slot0: u32) {
+fn solve_path(first: u32, end: u32, slot0: u32) -> bool {
     let n = end - first;
     if (path_settled(first, end)) {
-        return;
+        return false;
     }
+    var widest = 0.0; // the widest gap this solve closes (PATH_RECHECK)
     var held: array<PathEnd, 2>;
     held[0].i = NONE;
     held[1].i = NONE;
@@ -773,6 +779,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
         let a = path_end(j.body, held, false);
         let b = path_end(j.partner, held, false);
         let pj = path_joint(j, a.s, b.s);
+        widest = max(widest, length(pj.close));
         var m = end_response(a, pj.ra, pj.ra) + end_response(b, pj.rb, pj.rb);
         let link = shared_end(a.i, b.i, vec2<u32>(held[0].i, held[1].i));
         var coupling = mat3x3<f32>();
@@ -877,6 +884,7 @@ fn solve_path(first: u32, end: u32, slot0: u32) {
             wait.i = NONE;
         }
     }
+    return widest > PATH_RECHECK;
 }
 
 // The joints of path gid.x of this pass's colour, if it is of the kind asked
@@ -901,14 +909,32 @@ fn colour_path(gid: vec3<u32>, direct: bool) -> vec2<u32> {
     return vec2<u32>(first, joint_start[at + 1u]);
 }
 
-// Pass "solve_paths", twice a substep (after its first solve and its last),
-// once per colour, one invocation per chain or path cut from a larger
-// island: the path solved directly (solve_path).
+// A path solved directly closes its gaps to within what its turns leave of
+// the linear answer, about gap^2 / 2r for a lever r: a solve of gaps up to
+// this (m) leaves them within JOINT_SETTLED for levers of 5 cm or more.
+const PATH_RECHECK: f32 = 1e-3;
+
+// Pass "solve_paths", once per colour after a substep's first sweep, and
+// again after its last (twice after a single one) where the contacts pushed
+// a jointed body since the substep began or a first solve closed a gap wider
+// than PATH_RECHECK (status[STATUS_PATHS_AGAIN]): where paths meet a path's
+// solve moves their shared bodies, and the colours' turns carry that, but
+// only under load do their joints need it twice (docs/decisions/joints.md).
+// One invocation per chain or path cut from a larger island: the path
+// solved directly (solve_path).
 @compute @workgroup_size(PATH_WORKGROUP)
 fn solve_paths(@builtin(global_invocation_id) gid: vec3<u32>) {
+    // (no invocation of a second solve sets it: all read the same)
+    if (params.second != 0u && atomicLoad(&status[STATUS_PATHS_AGAIN]) == 0u) {
+        return;
+    }
     let path = colour_path(gid, true);
-    if (path.x != NONE) {
-        solve_path(path.x, path.y, path.x - joint_start[params.body_count + params.island_count + 2u]);
+    if (path.x == NONE) {
+        return;
+    }
+    let wide = solve_path(path.x, path.y, path.x - joint_start[params.body_count + params.island_count + 2u]);
+    if (wide && params.second == 0u) {
+        atomicStore(&status[STATUS_PATHS_AGAIN], 1u);
     }
 }
 

@@ -14,7 +14,7 @@ use crate::limits::NO_FAULT;
 /// take (`Status::walk_dispatches`).
 pub const WALK_DISPATCHES: usize = 5;
 
-/// The status words, in buffer order (180 bytes). The host reads it back
+/// The status words, in buffer order (184 bytes). The host reads it back
 /// after each batch of steps (`World::fit_pools`), and on request.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -80,6 +80,10 @@ pub struct Status {
     /// counts them): which weight solve_contacts gives its pushes
     /// (solve.wgsl's `sweep_weight`).
     pub sweeps: u32,
+    /// 1 if the substep's second `solve_paths` has work: the contacts
+    /// pushed a jointed body (`solve`), or a first solve closed a gap wider
+    /// than `PATH_RECHECK` (solve.wgsl); integrate clears it.
+    pub paths_again: u32,
 }
 
 /// The word index of a field of `Status`.
@@ -121,12 +125,13 @@ impl Status {
         walks_cut: 0,
         lists_cut: 0,
         sweeps: 0,
+        paths_again: 0,
     };
 
     /// The WGSL name and the first word of every field, in order: the
     /// shared constants (`shaders::shared_constants`) by which WGSL indexes
     /// the status words.
-    pub const WORDS: [(&'static str, u32); 23] = [
+    pub const WORDS: [(&'static str, u32); 24] = [
         ("STATUS_PAIRS", word!(pairs)),
         ("STATUS_PAIRS_MAX", word!(pairs_max)),
         ("STATUS_FAULT", word!(fault)),
@@ -150,6 +155,7 @@ impl Status {
         ("STATUS_WALKS_CUT", word!(walks_cut)),
         ("STATUS_LISTS_CUT", word!(lists_cut)),
         ("STATUS_SWEEPS", word!(sweeps)),
+        ("STATUS_PATHS_AGAIN", word!(paths_again)),
     ];
 }
 

@@ -126,7 +126,8 @@ pub struct Params {
     /// The paths of every colour (whether each is swept or solved directly
     /// follows their starts in `joint_start`).
     pub path_count: u32,
-    pub _pad1: u32,
+    /// 1 in the slots of a substep's second `solve_paths`, one a colour.
+    pub second: u32,
     pub _pad2: u32,
 }
 

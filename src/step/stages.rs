@@ -361,8 +361,8 @@ pub(crate) const TABLE: [StageInfo; 25] = {
             over: Over::Paths,
             poses: Poses::InPlace,
             runs: Runs::InSubsteps,
-            reads: &[Params, Props, StateOut, JointStart, JointRefs, PathScratch],
-            writes: &[StateOut, PathScratch],
+            reads: &[Params, Props, StateOut, Status, JointStart, JointRefs, PathScratch],
+            writes: &[StateOut, Status, PathScratch],
             ..S::row(Stage::SolvePaths, "solve_paths", SOLVE_PASS, Part::Solve)
         },
         S {

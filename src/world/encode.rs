@@ -19,9 +19,16 @@ pub(super) const MAX_BATCH: usize = 64;
 
 impl World {
     /// The Params slots a substep takes: its own, then one per colour of
-    /// the joint paths (`solve_joints` reads its colour's paths from it).
+    /// the joint paths (`solve_joints` and the first `solve_paths` read
+    /// their colour's paths from it), and where paths are solved directly
+    /// one more per colour for the second `solve_paths` (`Params::second`).
     pub(super) fn slots_per_substep(&self) -> usize {
-        self.path_colours.len().max(1)
+        1 + self.colour_count() * (1 + usize::from(self.path_kinds.1))
+    }
+
+    /// The colours of the joint paths.
+    fn colour_count(&self) -> usize {
+        self.path_colours.len().saturating_sub(1)
     }
 
     /// The steps a batch holds: as many as the Params buffer has slots for
@@ -69,9 +76,11 @@ impl World {
                     path_count: self.path_colours.last().copied().unwrap_or(0),
                     ..Params::default()
                 };
-                // the substep's own, then one per colour of the joint paths
-                let colours = self.path_colours.windows(2).map(|w| (w[0], w[1]));
-                for p in std::iter::once(p).chain(colours.map(|(first, end)| Params { path_first: first, path_end: end, ..p })) {
+                // the substep's own, then one per colour of the joint paths,
+                // and one per colour for the second solve of the paths solved directly
+                let coloured = self.path_colours.windows(2).map(|w| Params { path_first: w[0], path_end: w[1], ..p });
+                let second = coloured.clone().filter(|_| self.path_kinds.1).map(|p| Params { second: 1, ..p });
+                for p in std::iter::once(p).chain(coloured).chain(second) {
                     let at = slot * PARAMS_STRIDE as usize;
                     slots[at..at + size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
                     slot += 1;
@@ -203,16 +212,18 @@ impl World {
                     if sub == 0 && sweep == 0 && self.settings.sleeping {
                         plan.extend([Stage::JointRestClear, Stage::JointRestGather, Stage::JointRest].map(|s| (s, at)));
                     }
+                    let colours = self.colour_count();
                     if swept {
-                        plan.extend((1..per_substep).map(|c| (Stage::SolveJoints, at + c)));
+                        plan.extend((1..=colours).map(|c| (Stage::SolveJoints, at + c)));
                     }
-                    // the paths solved directly twice a substep: after its first sweep
-                    // and after its last, both after a single one (docs/decisions/joints.md)
-                    let rounds = usize::from(sweep == 0) + usize::from(sweep + 1 == sweeps);
-                    if direct {
-                        for _ in 0..rounds {
-                            plan.extend((1..per_substep).map(|c| (Stage::SolvePaths, at + c)));
-                        }
+                    // the paths solved directly after a substep's first sweep, and
+                    // where needed after its last (both after a single one; solve.wgsl's
+                    // solve_paths), the second from the slots after the first's
+                    if direct && sweep == 0 {
+                        plan.extend((1..=colours).map(|c| (Stage::SolvePaths, at + c)));
+                    }
+                    if direct && sweep + 1 == sweeps {
+                        plan.extend((1..=colours).map(|c| (Stage::SolvePaths, at + colours + c)));
                     }
                 }
             }

@@ -71,7 +71,7 @@ fn shared_structs_match_member_by_member() {
             path_first,
             path_end,
             path_count,
-            _pad1,
+            second,
             _pad2
         }
     );
@@ -251,6 +251,7 @@ fn status_words_match_the_struct() {
         walks_cut => "STATUS_WALKS_CUT",
         lists_cut => "STATUS_LISTS_CUT",
         sweeps => "STATUS_SWEEPS",
+        paths_again => "STATUS_PATHS_AGAIN",
     );
     assert_eq!(Status::BYTES as usize, size_of::<Status>());
     // a dispatch's three words as wgpu reads them: x, y, z

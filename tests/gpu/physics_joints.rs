@@ -485,7 +485,7 @@ fn a_door_on_two_hinges_turns_about_them() {
 /// edge), which is cut into paths: a joint to the world only starts a path,
 /// so no path holds the door at both hinges; the hinges' two paths take
 /// turns. Measured after 300 steps, the chain swinging down: the widest gap
-/// 1.45 mm (7.43 mm when one path took both hinges).
+/// 1.90 mm (7.43 mm when one path took both hinges).
 #[test]
 fn a_door_on_two_hinges_holds_a_long_chain() {
     let mut scene = scenes::chain(200);
