@@ -42,9 +42,9 @@ fn products_on(gpu: &Gpu) -> [f32; 2] {
         pass.dispatch_workgroups(1, 1, 1);
     }
     encoder.copy_buffer_to_buffer(&buffer, 0, &out, 0, 16);
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder.finish());
     out.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    gpu.wait().unwrap();
     let view = out.slice(..).get_mapped_range().unwrap();
     let read: &[f32] = bytemuck::cast_slice(&view);
     [read[2], read[3]]
