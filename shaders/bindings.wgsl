@@ -211,16 +211,18 @@ fn pairs_kept() -> bool {
 // scatter and sort, the pair scan and writes, and the ground's narrowphase,
 // which a kept list, empty, gives no pair), in the order of `Over::walk`:
 // over the buckets, the grid scan's blocks, the bodies, the pair scan's
-// blocks, one workgroup; or to nothing, so that a step that keeps its list
-// pays no invocation for them.
+// blocks, one workgroup, the bodies again (contact_lists); or to nothing, so
+// that a step that keeps its list pays no invocation for them, but one
+// workgroup for contact_lists, whose first invocation's part runs every step.
 fn size_walk_passes(walks: bool) {
     let buckets = (params.hash_size + WORKGROUP - 1u) / WORKGROUP;
     let scan_blocks = (params.hash_size + SCAN_SPAN - 1u) / SCAN_SPAN;
     let bodies = (params.body_count + WORKGROUP - 1u) / WORKGROUP;
     let body_scan_blocks = (params.body_count + SCAN_SPAN - 1u) / SCAN_SPAN;
-    let sizes = array<u32, 5>(buckets, scan_blocks, bodies, body_scan_blocks, 1u);
-    for (var k = 0u; k < 5u; k = k + 1u) {
-        atomicStore(&status[STATUS_WALK_DISPATCHES + 3u * k], select(0u, max(sizes[k], 1u), walks));
+    let sizes = array<u32, 6>(buckets, scan_blocks, bodies, body_scan_blocks, 1u, bodies);
+    let kept = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 1u);
+    for (var k = 0u; k < 6u; k = k + 1u) {
+        atomicStore(&status[STATUS_WALK_DISPATCHES + 3u * k], select(kept[k], max(sizes[k], 1u), walks));
     }
 }
 

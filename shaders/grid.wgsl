@@ -98,11 +98,6 @@ fn grid_count(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&status[STATUS_MANIFOLDS_TOP], 0u);
         atomicStore(&status[STATUS_MANIFOLDS_BOTTOM], 0u);
         atomicStore(&status[STATUS_MOVING], 0u);
-        // contact_lists lists the bodies and counts their workgroups
-        atomicStore(&status[STATUS_LISTED], 0u);
-        atomicStore(&status[STATUS_LISTED_DISPATCH], 0u);
-        atomicStore(&status[STATUS_TOUCHING], 0u);
-        atomicStore(&status[STATUS_TOUCHING_DISPATCH], 0u);
         // the bodies kept out of the grid have no place in it to compare with
         atomicMax(&status[STATUS_WALK], u32(params.large_count != 0u));
         // (walking already: the other invocations only ever set it)

@@ -314,7 +314,10 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         // the walk's passes are sized anew by the next grid_count
         size_walk_passes(false);
     }
-    if (i >= params.body_count) {
+    // a step that keeps the last walks' list, empty, keeps what this pass
+    // made of it then: no body touches, and the body lists stand (a body
+    // that slept since stays listed, which changes nothing)
+    if (i >= params.body_count || atomicLoad(&status[STATUS_KEPT]) != 0u) {
         return;
     }
     let first = pair_meta[i].list_start;

@@ -278,19 +278,32 @@ fn walk(i: u32) {
 // where it goes, does not depend on which invocation walks it.
 @compute @workgroup_size(WORKGROUP)
 fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
+    // (grid_count has decided: `walk` stands until contact_lists)
+    let kept = pairs_kept();
+    if (gid.x == 0u) {
+        atomicStore(&status[STATUS_KEPT], u32(kept));
+        if (!kept) {
+            // contact_lists lists the bodies anew and counts their workgroups
+            atomicStore(&status[STATUS_LISTED], 0u);
+            atomicStore(&status[STATUS_LISTED_DISPATCH], 0u);
+            atomicStore(&status[STATUS_TOUCHING], 0u);
+            atomicStore(&status[STATUS_TOUCHING_DISPATCH], 0u);
+        }
+    }
     if (gid.x < params.body_count) {
         let i = sorted[gid.x];
-    // the grid's arrivals are done with: the body lists start empty (`listed_body`, `touching_body`)
-        sorted[LISTED_RUN * params.body_count + gid.x] = NONE;
-        sorted[TOUCHING_RUN * params.body_count + gid.x] = NONE;
-        if (pairs_kept()) {
-            // the last walks' list, empty, stands, and so does the grid (its
-            // scans, scatter and sort do not run): the counts start again at 0
+        if (kept) {
+            // the last walks' list, empty, stands, and so do the grid (its
+            // scans, scatter and sort do not run) and the body lists made
+            // from it (`listed_body`; none touches): the counts start again at 0
             if (in_grid(i)) {
                 atomicStore(&cell_count[bucket_of(cell_of(state_of(i).pos))], 0u);
             }
             return;
         }
+        // the grid's arrivals are done with: the body lists start empty (`listed_body`, `touching_body`)
+        sorted[LISTED_RUN * params.body_count + gid.x] = NONE;
+        sorted[TOUCHING_RUN * params.body_count + gid.x] = NONE;
         // (the pairs the last walks counted: the scan has not yet written this step's)
         let listed_none = atomicLoad(&status[STATUS_PAIRS]) == 0u;
         if (gid.x == 0u && !listed_none) {

@@ -12,9 +12,9 @@ use crate::limits::NO_FAULT;
 
 /// How many sizes the passes that run only where a step walks for pairs
 /// take (`Status::walk_dispatches`).
-pub const WALK_DISPATCHES: usize = 5;
+pub const WALK_DISPATCHES: usize = 6;
 
-/// The status words, in buffer order (184 bytes). The host reads it back
+/// The status words, in buffer order (188 bytes). The host reads it back
 /// after each batch of steps (`World::fit_pools`), and on request.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -84,6 +84,10 @@ pub struct Status {
     /// pushed a jointed body (`solve`), or a first solve closed a gap wider
     /// than `PATH_RECHECK` (solve.wgsl); integrate clears it.
     pub paths_again: u32,
+    /// 1 if this step keeps the last walks' pair list, empty (`pairs_kept`),
+    /// and with it the body lists contact_lists made then: pairs_count sets
+    /// it for contact_lists, whose first invocation sets `walk` for the next step.
+    pub kept: u32,
 }
 
 /// The word index of a field of `Status`.
@@ -126,12 +130,13 @@ impl Status {
         lists_cut: 0,
         sweeps: 0,
         paths_again: 0,
+        kept: 0,
     };
 
     /// The WGSL name and the first word of every field, in order: the
     /// shared constants (`shaders::shared_constants`) by which WGSL indexes
     /// the status words.
-    pub const WORDS: [(&'static str, u32); 24] = [
+    pub const WORDS: [(&'static str, u32); 25] = [
         ("STATUS_PAIRS", word!(pairs)),
         ("STATUS_PAIRS_MAX", word!(pairs_max)),
         ("STATUS_FAULT", word!(fault)),
@@ -156,6 +161,7 @@ impl Status {
         ("STATUS_LISTS_CUT", word!(lists_cut)),
         ("STATUS_SWEEPS", word!(sweeps)),
         ("STATUS_PATHS_AGAIN", word!(paths_again)),
+        ("STATUS_KEPT", word!(kept)),
     ];
 }
 

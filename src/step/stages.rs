@@ -74,6 +74,10 @@ pub(crate) enum Over {
     WalkBodyScanBlocks,
     /// A single workgroup.
     WalkOne,
+    /// The bodies where the step walks, a single workgroup where it keeps
+    /// its list: `contact_lists`, whose first invocation's part runs every
+    /// step, and whose lists of a kept step stand.
+    WalkBodiesOrOne,
 }
 
 impl Over {
@@ -86,6 +90,7 @@ impl Over {
             Over::WalkBodies => 2,
             Over::WalkBodyScanBlocks => 3,
             Over::WalkOne => 4,
+            Over::WalkBodiesOrOne => 5,
             _ => return None,
         })
     }
@@ -202,7 +207,14 @@ pub(crate) const TABLE: [StageInfo; 25] = {
             reads: &[Params, Props, StateIn, CellCount, Status, Sorted, PairMeta, CellBounds, Hulls],
             writes: &[CellCount, Status, PairMeta],
             // what the walk's passes are over this step, sized as the pass ends
-            copy_after: &[Over::WalkBuckets, Over::WalkScanBlocks, Over::WalkBodies, Over::WalkBodyScanBlocks, Over::WalkOne],
+            copy_after: &[
+                Over::WalkBuckets,
+                Over::WalkScanBlocks,
+                Over::WalkBodies,
+                Over::WalkBodyScanBlocks,
+                Over::WalkOne,
+                Over::WalkBodiesOrOne,
+            ],
             ..S::row(Stage::GridCount, "grid_count", GRID_PASS, Broadphase)
         },
         S {
@@ -291,6 +303,7 @@ pub(crate) const TABLE: [StageInfo; 25] = {
             ..S::row(Stage::NarrowphaseGround, "narrowphase_ground", NARROWPHASE_PASS, Narrowphase)
         },
         S {
+            over: Over::WalkBodiesOrOne,
             reads: &[Params, Props, StateIn, Manifolds, Status, JointStart, PairMeta, BodyPairs],
             writes: &[Sorted, Status, PairMeta, BodyPairs],
             // once, for every contact and body pass of the step's substeps

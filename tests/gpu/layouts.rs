@@ -252,6 +252,7 @@ fn status_words_match_the_struct() {
         lists_cut => "STATUS_LISTS_CUT",
         sweeps => "STATUS_SWEEPS",
         paths_again => "STATUS_PATHS_AGAIN",
+        kept => "STATUS_KEPT",
     );
     assert_eq!(Status::BYTES as usize, size_of::<Status>());
     // a dispatch's three words as wgpu reads them: x, y, z
