@@ -14,7 +14,7 @@ use crate::limits::NO_FAULT;
 /// take (`Status::walk_dispatches`).
 pub const WALK_DISPATCHES: usize = 6;
 
-/// The status words, in buffer order (188 bytes). The host reads it back
+/// The status words, in buffer order (200 bytes). The host reads it back
 /// after each batch of steps (`World::fit_pools`), and on request.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -69,8 +69,8 @@ pub struct Status {
     pub walk: u32,
     /// The indirect dispatches of the passes that run only where the step
     /// walks (`Over::walk` orders them): at full size once the step
-    /// walks (grid_count), none as the step ends (contact_lists); copied
-    /// out after grid_count.
+    /// walks (grid_count), none as the step ends (contact_lists; one
+    /// workgroup for contact_lists itself); copied out after grid_count.
     pub walk_dispatches: [[u32; 3]; WALK_DISPATCHES],
     /// 1 once a pair walk took so many loop trips that the driver may have cut it short (LOOP_TRIPS); never cleared.
     pub walks_cut: u32,
