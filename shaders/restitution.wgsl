@@ -181,8 +181,13 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     let turns_a = select(turn_scale(k_a), 1.0, mean);
     let turns_b = select(turn_scale(k_b), 1.0, mean);
     let counted = select(min(acting, 1u), acting, mean);
-    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, counted, flags));
-    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, counted, flags));
+    // for the ends that move alone (see solve_contacts)
+    if (ea.moves) {
+        set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, counted, flags));
+    }
+    if (eb.moves) {
+        set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, counted, flags));
+    }
 }
 
 // The body half: body i's state with what its manifolds ask applied (summed in
@@ -247,4 +252,18 @@ fn restitution(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     set_state(i, restituted(i, state_of(i), props_of(i), true));
+}
+
+// In place of `restitution` in a world where no body sleeps, over the listed
+// bodies with contacts alone (each reads and writes only its own pose, and
+// the snaps were measured in the pass before): every body is listed in
+// every pass there, so one that touches nothing needs no copy into the
+// other buffer, where the next step's integrate writes it.
+@compute @workgroup_size(WORKGROUP)
+fn restitution_in_place(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = touching_body(gid.x);
+    if (i >= params.body_count) {
+        return;
+    }
+    set_state(i, restituted(i, out_state(i), props_of(i), true));
 }

@@ -34,6 +34,7 @@ pub enum Stage {
     SolvePaths,
     RestitutionContacts,
     Restitution,
+    RestitutionInPlace,
 }
 
 /// What one invocation of a stage works on, which sizes its dispatch.
@@ -189,7 +190,7 @@ impl StageInfo {
 }
 
 /// Every stage, in the order of `Stage` (checked as the table is built).
-pub(crate) const TABLE: [StageInfo; 25] = {
+pub(crate) const TABLE: [StageInfo; 26] = {
     use shaders::{GRID_PASS, INTEGRATE_PASS, NARROWPHASE_PASS, PAIRS_PASS, RESTITUTION_PASS, SOLVE_PASS};
     use Buffer::*;
     use Part::{Broadphase, Narrowphase};
@@ -394,6 +395,15 @@ pub(crate) const TABLE: [StageInfo; 25] = {
             reads: &[Params, Props, StateIn, Sorted, Snaps, PairMeta, BodyPairs, Snaps1],
             writes: &[StateOut],
             ..S::row(Stage::Restitution, "restitution", RESTITUTION_PASS, Part::Restitution)
+        },
+        S {
+            // in place of `restitution` where no body sleeps (`World::step_plan`)
+            over: Over::Touching,
+            poses: Poses::InPlace,
+            runs: Runs::InSubsteps,
+            reads: &[Params, Props, StateOut, Sorted, Snaps, PairMeta, BodyPairs, Snaps1],
+            writes: &[StateOut],
+            ..S::row(Stage::RestitutionInPlace, "restitution_in_place", RESTITUTION_PASS, Part::Restitution)
         },
     ];
     // each row sits at its stage's index

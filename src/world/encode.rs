@@ -230,7 +230,10 @@ impl World {
             plan.push((Stage::RestitutionContacts, at));
             // the next substep's integrate applies what it asks (integrate.wgsl)
             if sub + 1 == self.settings.substeps as usize {
-                plan.push((Stage::Restitution, at));
+                // where no body sleeps every body is listed in every pass, and
+                // one that touches nothing holds its pose as integrate wrote it
+                let last = if self.settings.sleeping { Stage::Restitution } else { Stage::RestitutionInPlace };
+                plan.push((last, at));
             }
         }
         plan
