@@ -131,6 +131,23 @@ fn set_state(i: u32, s: BodyState) {
     state_out[i] = StateWords(vec4<f32>(s.pos, s.rest_time), vec4<f32>(s.disp, bitcast<f32>(s.pos_low)), s.rot, s.prev_rot);
 }
 
+// Body i's pose in state_out without its previous rotation (left at none),
+// for a pass that moves the pose in place and turns the previous rotation
+// only now and then (solve: where it settles): the words it does not need
+// are neither loaded nor stored (`set_pose`).
+fn out_pose(i: u32) -> BodyState {
+    let a = state_out[i].a;
+    let b = state_out[i].b;
+    return BodyState(a.xyz, a.w, b.xyz, bitcast<u32>(b.w), state_out[i].rot, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+}
+
+// Stores body i's pose but its previous rotation (see out_pose).
+fn set_pose(i: u32, s: BodyState) {
+    state_out[i].a = vec4<f32>(s.pos, s.rest_time);
+    state_out[i].b = vec4<f32>(s.disp, bitcast<f32>(s.pos_low));
+    state_out[i].rot = s.rot;
+}
+
 fn set_rest_time(i: u32, rest: f32) {
     state_out[i].a.w = rest;
 }

@@ -282,7 +282,8 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (pair_meta[i].contacts == 0u) {
         return;
     }
-    var s = out_state(i);
+    // (its previous rotation is read and written where it settles alone)
+    var s = out_pose(i);
     let p = props_of(i);
     if (is_fixed(p) || is_kinematic(p) || asleep(s)) {
         return;
@@ -362,7 +363,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
         let share = params.relaxation / f32(settling);
         s.pos = s.pos + settle.dx * share;
         s.rot = quat_add_rotation(s.rot, settle.dtheta * share);
-        s.prev_rot = quat_add_rotation(s.prev_rot, settle.dtheta * share);
+        state_out[i].prev_rot = quat_add_rotation(state_out[i].prev_rot, settle.dtheta * share);
     }
     // The ground stays whatever presses on it: partners far heavier than a
     // body outweigh its ground contact in the sum, and a pile of heavy boxes
@@ -387,7 +388,7 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
     }
-    set_state(i, s);
+    set_pose(i, s);
 }
 
 // How far body i, at pose s, must move to be no deeper than GROUND_DEPTH in
