@@ -316,7 +316,7 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // a step that keeps the last walks' list, empty, keeps what this pass
     // made of it then: no body touches, and the body lists stand (a body
-    // that slept since stays listed, which changes nothing)
+    // that falls asleep or wakes changes its `moves`, and the step walks)
     if (i >= params.body_count || atomicLoad(&status[STATUS_KEPT]) != 0u) {
         return;
     }
