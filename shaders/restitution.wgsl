@@ -181,13 +181,8 @@ fn restitution_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
     let turns_a = select(turn_scale(k_a), 1.0, mean);
     let turns_b = select(turn_scale(k_b), 1.0, mean);
     let counted = select(min(acting, 1u), acting, mean);
-    // for the ends that move alone (see solve_contacts)
-    if (ea.moves) {
-        set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, counted, flags));
-    }
-    if (eb.moves) {
-        set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, counted, flags));
-    }
+    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, counted, flags));
+    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, counted, flags));
 }
 
 // The body half: body i's state with what its manifolds ask applied (summed in

@@ -257,14 +257,8 @@ fn solve_contacts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let flags = select(0u, SNAP_PRESSED, pressed != 0u) | (settle << SETTLE_SHIFT) | (support << SUPPORT_SHIFT);
     let against_a = select(0u, SNAP_FIXED_PARTNER, eb.fixed);
     let against_b = select(0u, SNAP_FIXED_PARTNER, ea.fixed);
-    // only a body that moves reads its snaps (solve, restitution): the
-    // ground's, a fixed body's or a sleeper's would be stored for nothing
-    if (ea.moves) {
-        set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, touched | against_a, flags));
-    }
-    if (eb.moves) {
-        set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, touched | against_b, flags));
-    }
+    set_snap(contact_ref(k, false), end_snap(ea, -j, -moment_a * turns_a, touched | against_a, flags));
+    set_snap(contact_ref(k, true), end_snap(eb, j, moment_b * turns_b, touched | against_b, flags));
 }
 
 @compute @workgroup_size(WORKGROUP)
