@@ -5,10 +5,11 @@
 //! they share end with the same bits.
 
 use verlet::gpu::types::{BodyState, SCAN_SPAN, WORKGROUP};
+use verlet::scene::SLEEP_AFTER;
 use verlet::scenes::{box_body, sphere_body};
 use verlet::step::Stage;
 use verlet::world::plan_grid;
-use verlet::{scenes, Scene, World};
+use verlet::{scenes, Joint, Scene, World, WORLD};
 
 use crate::common::world;
 
@@ -124,4 +125,29 @@ fn an_edit_into_contact_after_kept_steps_is_found() {
     assert!(raw(&kept, n) == raw(&walked, n), "the grid pushed by the post differs from a run that walks every step");
     let moved = kept.read_state().unwrap()[lowest].position;
     assert!(moved[0].abs() > 1e-3 || moved[2].abs() > 1e-3, "the post did not push the ball: {moved:?}");
+}
+
+/// Two pendulums far apart and far from anything, sleeping on: one hangs
+/// still and falls asleep, the other swings and keeps the world awake. The
+/// steps keep the list (nothing near), and the body lists `contact_lists`
+/// made stand on them; a body falling asleep changes its `moves`, so that
+/// step walks and lists it anew, and the bits are those of a run that
+/// walks every step.
+#[test]
+fn a_body_falling_asleep_between_kept_steps_ends_as_where_every_step_walks() {
+    let mut scene = Scene { ground: None, ..scenes::stack(0) };
+    scene.settings.sleeping = true;
+    let still = box_body([0.2; 3], [0.0, -1.0, 0.0]);
+    let swinging = box_body([0.2; 3], [30.0 + 0.8, -0.6, 0.0]);
+    scene.bodies = vec![still, swinging];
+    scene.joints = vec![
+        Joint { bodies: [0, WORLD], anchors: [[0.0, 1.0, 0.0], [0.0, 0.0, 0.0]] },
+        Joint { bodies: [1, WORLD], anchors: [[0.0, 1.0, 0.0], [30.0, 0.0, 0.0]] },
+    ];
+    let Some((kept, a, b)) = both(&scene, 150) else { return };
+    let status = kept.read_status().unwrap();
+    assert_eq!((status.near, status.pairs), (0, 0), "{status:?}");
+    assert!(a[0].rest_time >= SLEEP_AFTER, "the still pendulum did not fall asleep: rest {} s", a[0].rest_time);
+    assert!(a[1].rest_time < SLEEP_AFTER, "the swinging pendulum fell asleep");
+    assert!(a == b, "the pendulums' states differ from a run that walks every step");
 }
