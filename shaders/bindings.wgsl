@@ -237,9 +237,9 @@ fn size_walk_passes(walks: bool) {
     let bodies = (params.body_count + WORKGROUP - 1u) / WORKGROUP;
     let body_scan_blocks = (params.body_count + SCAN_SPAN - 1u) / SCAN_SPAN;
     let sizes = array<u32, 6>(buckets, scan_blocks, bodies, body_scan_blocks, 1u, bodies);
-    let kept = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 1u);
+    let keeping = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 1u);
     for (var k = 0u; k < 6u; k = k + 1u) {
-        atomicStore(&status[STATUS_WALK_DISPATCHES + 3u * k], select(kept[k], max(sizes[k], 1u), walks));
+        atomicStore(&status[STATUS_WALK_DISPATCHES + 3u * k], select(keeping[k], max(sizes[k], 1u), walks));
     }
 }
 
