@@ -228,9 +228,10 @@ fn pairs_kept() -> bool {
 // scatter and sort, the pair scan and writes, and the ground's narrowphase,
 // which a kept list, empty, gives no pair), in the order of `Over::walk`:
 // over the buckets, the grid scan's blocks, the bodies, the pair scan's
-// blocks, one workgroup, the bodies again (contact_lists); or to nothing, so
-// that a step that keeps its list pays no invocation for them, but one
-// workgroup for contact_lists, whose first invocation's part runs every step.
+// blocks, one workgroup, the bodies again (pairs_count, contact_lists); or
+// to nothing, so that a step that keeps its list pays no invocation for
+// them, but one workgroup for pairs_count and contact_lists, whose first
+// invocations' parts run every step.
 fn size_walk_passes(walks: bool) {
     let buckets = (params.hash_size + WORKGROUP - 1u) / WORKGROUP;
     let scan_blocks = (params.hash_size + SCAN_SPAN - 1u) / SCAN_SPAN;

@@ -293,12 +293,9 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x < params.body_count) {
         let i = sorted[gid.x];
         if (kept) {
-            // the last walks' list, empty, stands, and so do the grid (its
-            // scans, scatter and sort do not run) and the body lists made
-            // from it (`listed_body`; none touches): the counts start again at 0
-            if (in_grid(i)) {
-                atomicStore(&cell_count[bucket_of(cell_of(state_of(i).pos))], 0u);
-            }
+            // (dispatched at one workgroup) the last walks' list, empty,
+            // stands, and so do the grid (its scans, scatter and sort do not
+            // run) and the body lists made from it (`listed_body`; none touches)
             return;
         }
         // the grid's arrivals are done with: the body lists start empty (`listed_body`, `touching_body`)

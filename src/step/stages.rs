@@ -76,8 +76,8 @@ pub(crate) enum Over {
     /// A single workgroup.
     WalkOne,
     /// The bodies where the step walks, a single workgroup where it keeps
-    /// its list: `contact_lists`, whose first invocation's part runs every
-    /// step, and whose lists of a kept step stand.
+    /// its list: `pairs_count` and `contact_lists`, whose first invocations'
+    /// parts run every step (the lists of a kept step stand).
     WalkBodiesOrOne,
 }
 
@@ -165,6 +165,9 @@ pub(crate) struct StageInfo {
     /// so the step's passes are split there (`World::encode_step`).
     pub copy_before: &'static [Over],
     pub copy_after: &'static [Over],
+    /// Buffers filled with zeros once the stage has run (outside any
+    /// compute pass, as the copies).
+    pub clear_after: &'static [Buffer],
     pub part: Part,
 }
 
@@ -184,6 +187,7 @@ impl StageInfo {
             writes: &[],
             copy_before: &[],
             copy_after: &[],
+            clear_after: &[],
             part,
         }
     }
@@ -254,8 +258,10 @@ pub(crate) const TABLE: [StageInfo; 26] = {
             ..S::row(Stage::GridSort, "grid_sort", GRID_PASS, Broadphase)
         },
         S {
+            // its first invocation's part runs every step (`status.kept`)
+            over: Over::WalkBodiesOrOne,
             reads: &[Params, Props, StateIn, CellStart, Sorted, Pairs, Status, PairMeta, BodyPairs, CellBounds, Hulls],
-            writes: &[CellCount, Sorted, Pairs, Status, PairMeta, BodyPairs],
+            writes: &[Sorted, Pairs, Status, PairMeta, BodyPairs],
             ..S::row(Stage::PairsCount, "pairs_count", PAIRS_PASS, Narrowphase)
         },
         S {
@@ -309,6 +315,9 @@ pub(crate) const TABLE: [StageInfo; 26] = {
             writes: &[Sorted, Status, PairMeta, BodyPairs],
             // once, for every contact and body pass of the step's substeps
             copy_after: &[Over::Manifolds, Over::Listed, Over::Touching],
+            // what grid_count counted on a step that kept its list, which no
+            // scatter took back: the next step counts from 0
+            clear_after: &[CellCount],
             ..S::row(Stage::ContactLists, "contact_lists", NARROWPHASE_PASS, Narrowphase)
         },
         S {

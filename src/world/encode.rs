@@ -134,10 +134,11 @@ impl World {
                     .forget_lifetime()
             });
             self.dispatch(open, stage, first + sub);
-            if !info.copy_after.is_empty() {
+            if !info.copy_after.is_empty() || !info.clear_after.is_empty() {
                 drop(pass.take());
             }
             self.copy_dispatch_sizes(encoder, stage, false);
+            self.clear_after(encoder, stage);
         }
     }
 
@@ -158,6 +159,14 @@ impl World {
         }
         for (slot, words, len) in runs {
             encoder.copy_buffer_to_buffer(&self.data.status, words, &self.data.dispatch, slot, len);
+        }
+    }
+
+    /// The fills with zeros after `stage` (`StageInfo::clear_after`).
+    /// Outside any compute pass.
+    fn clear_after(&self, encoder: &mut wgpu::CommandEncoder, stage: Stage) {
+        for &buffer in stage.info().clear_after {
+            encoder.clear_buffer(self.data.buffer(buffer, self.current), 0, None);
         }
     }
 
@@ -255,6 +264,7 @@ impl World {
         self.dispatch(&mut pass, stage, slot);
         drop(pass);
         self.copy_dispatch_sizes(encoder, stage, false);
+        self.clear_after(encoder, stage);
     }
 
     /// Runs `stages` alone, in order, each as a step's first substep runs it,
