@@ -169,6 +169,10 @@ fn body_in_run(run: u32, k: u32) -> u32 {
 }
 
 fn listed_body(k: u32) -> u32 {
+    // where no body can sleep, every body is listed (contact_lists): by index
+    if (!SLEEPING) {
+        return select(NONE, k, k < params.body_count);
+    }
     return body_in_run(LISTED_RUN, k);
 }
 

@@ -313,6 +313,11 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&status[STATUS_WALK], atomicLoad(&status[STATUS_NEAR]));
         // the walk's passes are sized anew by the next grid_count
         size_walk_passes(false);
+        if (!SLEEPING) {
+            // every body, listed by index (`listed_body`)
+            atomicStore(&status[STATUS_LISTED], params.body_count);
+            atomicStore(&status[STATUS_LISTED_DISPATCH], (params.body_count + WORKGROUP - 1u) / WORKGROUP);
+        }
     }
     // a step that keeps the last walks' list, empty, keeps what this pass
     // made of it then: no body touches, and the body lists stand (a body
@@ -353,9 +358,12 @@ fn contact_lists(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the bodies the step may change, for the body passes (`listed_body`): all
     // but the sleepers held still that nothing woke or may wake (listing one
     // changes nothing: integrate holds it, restitution copies it), and of
-    // them those with contacts for `solve`
-    if (!sleeps_held(i) || atomicLoad(&pair_meta[i].woken) != 0u || may_wake) {
-        list_in_run(LISTED_RUN, STATUS_LISTED, STATUS_LISTED_DISPATCH, i);
+    // them those with contacts for `solve`; where none can sleep, every body
+    // (invocation 0 counts them) and no sleeper's state is read
+    if (!SLEEPING || !sleeps_held(i) || atomicLoad(&pair_meta[i].woken) != 0u || may_wake) {
+        if (SLEEPING) {
+            list_in_run(LISTED_RUN, STATUS_LISTED, STATUS_LISTED_DISPATCH, i);
+        }
         if (end > first) {
             list_in_run(TOUCHING_RUN, STATUS_TOUCHING, STATUS_TOUCHING_DISPATCH, i);
         }
