@@ -298,8 +298,12 @@ fn pairs_count(@builtin(global_invocation_id) gid: vec3<u32>) {
             // run) and the body lists made from it (`listed_body`; none touches)
             return;
         }
-        // the grid's arrivals are done with: the body lists start empty (`listed_body`, `touching_body`)
-        sorted[LISTED_RUN * params.body_count + gid.x] = NONE;
+        // the grid's arrivals are done with: the body lists start empty
+        // (`listed_body`, `touching_body`; where no body can sleep, every body
+        // is listed by its index and the listed run is not read)
+        if (SLEEPING) {
+            sorted[LISTED_RUN * params.body_count + gid.x] = NONE;
+        }
         sorted[TOUCHING_RUN * params.body_count + gid.x] = NONE;
         // (the pairs the last walks counted: the scan has not yet written this step's)
         let listed_none = atomicLoad(&status[STATUS_PAIRS]) == 0u;
