@@ -137,8 +137,7 @@ impl World {
             if !info.copy_after.is_empty() || !info.clear_after.is_empty() {
                 drop(pass.take());
             }
-            self.copy_dispatch_sizes(encoder, stage, false);
-            self.clear_after(encoder, stage);
+            self.transfers_after(encoder, stage);
         }
     }
 
@@ -162,9 +161,11 @@ impl World {
         }
     }
 
-    /// The fills with zeros after `stage` (`StageInfo::clear_after`).
-    /// Outside any compute pass.
-    fn clear_after(&self, encoder: &mut wgpu::CommandEncoder, stage: Stage) {
+    /// What follows `stage` outside any compute pass: the copies of the
+    /// dispatch sizes it wrote, then the fills with zeros
+    /// (`StageInfo::copy_after`, `clear_after`).
+    fn transfers_after(&self, encoder: &mut wgpu::CommandEncoder, stage: Stage) {
+        self.copy_dispatch_sizes(encoder, stage, false);
         for &buffer in stage.info().clear_after {
             encoder.clear_buffer(self.data.buffer(buffer, self.current), 0, None);
         }
@@ -263,8 +264,7 @@ impl World {
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(stage.name()), timestamp_writes: timestamps });
         self.dispatch(&mut pass, stage, slot);
         drop(pass);
-        self.copy_dispatch_sizes(encoder, stage, false);
-        self.clear_after(encoder, stage);
+        self.transfers_after(encoder, stage);
     }
 
     /// Runs `stages` alone, in order, each as a step's first substep runs it,
